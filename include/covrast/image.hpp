@@ -1,0 +1,41 @@
+// covrast public API: images and their files. The last stage of the pipeline; the only
+// part of covrast that includes stb.
+#pragma once
+
+#include <covrast/error.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <vector>
+
+namespace covrast {
+
+/// 8-bit sRGB-encoded RGB image, row 0 at the top, rows packed (stride = 3 * width).
+struct Image {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgb;
+  std::uint8_t* pixel(int x, int y) { return &rgb[(std::size_t(y) * width + x) * 3]; }
+  const std::uint8_t* pixel(int x, int y) const {
+    return &rgb[(std::size_t(y) * width + x) * 3];
+  }
+};
+
+/// Window depth per pixel in [0, 1] (0 = near plane, 1 = far plane); background = 1.
+struct DepthImage {
+  int width = 0;
+  int height = 0;
+  std::vector<float> depth;
+};
+
+/// Writes a PNG atomically: a temporary file beside the target, then rename, so that a
+/// failure never leaves a partial or overwritten file. Throws InputError naming the path.
+void write_png(const Image& image, const std::filesystem::path& path);
+
+/// Writes depth as 16-bit greyscale PNG (.png) or as a little-endian PFM (.pfm), atomically.
+void write_depth(const DepthImage& depth, const std::filesystem::path& path);
+
+/// Reads an 8-bit PNG (grey, grey+alpha, RGB or RGBA; alpha dropped). Throws InputError.
+Image read_png(const std::filesystem::path& path);
+
+}  // namespace covrast

@@ -1,0 +1,90 @@
+// covrast public API: the scene, as loaded from a JSON scene file (see docs/scene-format.md).
+// Loading is the first stage of the pipeline: scene -> geometry -> binning -> raster ->
+// resolve -> image. Everything here is in world units and linear-light colour; nothing
+// here knows about pixels except the requested image size.
+#pragma once
+
+#include <covrast/error.hpp>
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace covrast {
+
+/// Largest accepted image side [pixels]. Larger requests are refused as bad input.
+inline constexpr int kMaxImageSide = 16384;
+
+/// OpenGL conventions: view = lookAt(eye, target, up), projection =
+/// perspective(fovy, width / height of the output image, near, far), clip z in [-w, w].
+struct Camera {
+  glm::dvec3 eye{0.0, 0.0, 3.0};
+  glm::dvec3 target{0.0, 0.0, 0.0};
+  glm::dvec3 up{0.0, 1.0, 0.0};
+  double fovy_deg = 45.0;  ///< vertical field of view [degrees], in (0, 180)
+  double near = 0.1;       ///< near plane distance [world units], > 0
+  double far = 100.0;      ///< far plane distance [world units], > near
+};
+
+/// Triangle geometry shared by every instance that names the same file.
+struct MeshData {
+  std::string source;                   ///< file it came from (for messages)
+  std::vector<glm::vec3> positions;     ///< object space
+  std::vector<glm::vec3> colors_linear; ///< per vertex, linear light; empty if none
+  std::vector<std::uint32_t> indices;   ///< 3 per triangle, in file order after fan split
+  std::size_t triangle_count() const { return indices.size() / 3; }
+};
+
+enum class ColorSource {
+  Uniform,      ///< MeshInstance::color_linear for every triangle
+  PerTriangle,  ///< lowbias32(global triangle index) debug colouring
+  Vertex,       ///< MeshData::colors_linear, interpolated
+};
+
+struct MeshInstance {
+  std::shared_ptr<const MeshData> mesh;  ///< shared between instances of one file
+  glm::dmat4 model{1.0};                 ///< object -> world (GLM is column-major)
+  ColorSource color_source = ColorSource::Uniform;
+  glm::vec3 color_linear{1.0f};          ///< for ColorSource::Uniform
+  /// For Vertex colours coming from glTF: baseColorFactor, multiplied in (linear).
+  glm::vec3 color_factor_linear{1.0f};
+};
+
+struct Scene {
+  std::filesystem::path source;  ///< the JSON file (empty when built in code)
+  int width = 640;               ///< [pixels], 1..kMaxImageSide
+  int height = 360;              ///< [pixels], 1..kMaxImageSide
+  glm::vec3 background_linear{0.0f};
+  Camera camera;
+  std::vector<MeshInstance> meshes;
+  /// Triangles dropped at load time because a vertex had a NaN or infinite coordinate.
+  std::size_t dropped_nonfinite_triangles = 0;
+  /// One line each, e.g. "meshes/a.obj: dropped 3 triangles with NaN/Inf coordinates".
+  std::vector<std::string> warnings;
+
+  std::size_t triangle_count() const;
+};
+
+/// Loads a scene file. Throws InputError with a one-line message naming the file and the
+/// problem (with line and column for malformed JSON).
+Scene load_scene(const std::filesystem::path& json_path);
+
+/// Loads one mesh file (.obj, .gltf, .glb) by itself; used by load_scene and tests.
+/// For glTF the node transforms are baked into the positions and COLOR_0 x
+/// baseColorFactor into colors_linear.
+std::shared_ptr<MeshData> load_mesh(const std::filesystem::path& path);
+
+/// The per_triangle debug colour: h = lowbias32(index), r = (h & 255) / 255, g = (h >> 8 &
+/// 255) / 255, b = (h >> 16 & 255) / 255, as sRGB display values.
+std::uint32_t lowbias32(std::uint32_t x);
+glm::vec3 per_triangle_color_srgb(std::uint32_t global_triangle_index);
+
+/// sRGB transfer function (IEC 61966-2-1), both directions, on [0, 1].
+float srgb_to_linear(float encoded);
+float linear_to_srgb(float linear);
+
+}  // namespace covrast

@@ -1,0 +1,65 @@
+// The covrast command line: one function pair per subcommand (options registration, run)
+// plus the helpers they share. Uses only the public headers in include/covrast/.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace covrast::cli {
+
+/// The program version; must match project(covrast VERSION ...) in CMakeLists.txt.
+inline constexpr const char* kVersion = "0.1.0";
+
+struct RenderArgs {
+  std::string scene;
+  std::string output;
+  std::string mode = "coverage";
+  std::string size;  ///< "WxH"; empty: the scene's size
+  int threads = 0;
+  int tile = 64;
+  std::string depth;  ///< empty: no depth output
+  bool stats = false;
+  int repeat = 1;
+  bool strict = false;
+  bool quiet = false;
+};
+
+struct InfoArgs {
+  std::string scene;
+  bool json = false;
+};
+
+struct CompareArgs {
+  std::string image_a;
+  std::string image_b;
+  std::string heatmap;  ///< empty: no heat map
+  bool json = false;
+  std::optional<double> max_rmse;
+  std::optional<int> max_diff;
+  std::optional<double> max_pixels;
+};
+
+CLI::App* add_render_command(CLI::App& app, RenderArgs& args);
+CLI::App* add_info_command(CLI::App& app, InfoArgs& args);
+CLI::App* add_compare_command(CLI::App& app, CompareArgs& args);
+
+/// Each returns the process exit code; InputError and other exceptions propagate to main.
+int run_render(const RenderArgs& args);
+int run_info(const InfoArgs& args);
+int run_compare(const CompareArgs& args);
+
+/// Throws InputError unless `path` could be created or replaced: its directory exists, is a
+/// directory and is writable, the path is not a directory, and its extension (lower case) is
+/// one of `extensions`. Run before any expensive work, so a bad output path fails fast.
+void check_output_path(const std::filesystem::path& path,
+                       const std::vector<std::string_view>& extensions);
+
+/// Compact decimal form of a double for human-readable output ("%.6g"; "inf" for infinity).
+std::string format_number(double value);
+
+}  // namespace covrast::cli

@@ -1,0 +1,175 @@
+// `covrast info`: loads a scene and describes it (size, camera, meshes, totals, world-space
+// bounding box, warnings) as text or as one JSON line. Renders nothing.
+#include "commands.hpp"
+
+#include <covrast/scene.hpp>
+
+#include <glm/glm.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace covrast::cli {
+namespace {
+
+struct Bounds {
+  glm::dvec3 min{std::numeric_limits<double>::infinity()};
+  glm::dvec3 max{-std::numeric_limits<double>::infinity()};
+  bool empty() const { return !(min.x <= max.x); }
+};
+
+/// World-space bounds of the vertices that triangles reference (so vertices of triangles
+/// dropped at load time, and unused ones, do not count): world = model * (p, 1), divided by
+/// w when the model matrix is projective.
+Bounds world_bounds(const Scene& scene) {
+  Bounds bounds;
+  for (const MeshInstance& instance : scene.meshes) {
+    if (!instance.mesh) continue;
+    const MeshData& mesh = *instance.mesh;
+    std::vector<bool> used(mesh.positions.size(), false);
+    for (std::uint32_t index : mesh.indices) {
+      if (index < used.size()) used[index] = true;
+    }
+    for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
+      if (!used[i]) continue;
+      glm::dvec4 world = instance.model * glm::dvec4(glm::dvec3(mesh.positions[i]), 1.0);
+      if (world.w != 1.0 && world.w != 0.0) world /= world.w;
+      const glm::dvec3 p(world);
+      if (!std::isfinite(p.x) || !std::isfinite(p.y) || !std::isfinite(p.z)) continue;
+      bounds.min = glm::min(bounds.min, p);
+      bounds.max = glm::max(bounds.max, p);
+    }
+  }
+  return bounds;
+}
+
+const char* color_source_name(ColorSource source) {
+  switch (source) {
+    case ColorSource::Uniform:
+      return "uniform";
+    case ColorSource::PerTriangle:
+      return "per_triangle";
+    case ColorSource::Vertex:
+      return "vertex";
+  }
+  return "unknown";
+}
+
+nlohmann::json vec_json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+
+std::string vec_text(const glm::dvec3& v) {
+  return "(" + format_number(v.x) + ", " + format_number(v.y) + ", " + format_number(v.z) + ")";
+}
+
+std::size_t vertex_count(const MeshInstance& instance) {
+  return instance.mesh ? instance.mesh->positions.size() : 0;
+}
+
+std::size_t triangle_count(const MeshInstance& instance) {
+  return instance.mesh ? instance.mesh->triangle_count() : 0;
+}
+
+std::string mesh_source(const MeshInstance& instance) {
+  return instance.mesh ? instance.mesh->source : std::string();
+}
+
+nlohmann::json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
+                         std::size_t total_vertices) {
+  nlohmann::json j;
+  j["file"] = args.scene;
+  j["width"] = scene.width;
+  j["height"] = scene.height;
+  j["background_linear"] = vec_json(glm::dvec3(scene.background_linear));
+  j["camera"] = {{"eye", vec_json(scene.camera.eye)}, {"target", vec_json(scene.camera.target)},
+                 {"up", vec_json(scene.camera.up)},   {"fovy_deg", scene.camera.fovy_deg},
+                 {"near", scene.camera.near},         {"far", scene.camera.far}};
+  nlohmann::json meshes = nlohmann::json::array();
+  for (const MeshInstance& instance : scene.meshes) {
+    nlohmann::json m = {{"source", mesh_source(instance)},
+                        {"triangles", triangle_count(instance)},
+                        {"vertices", vertex_count(instance)},
+                        {"color_source", color_source_name(instance.color_source)}};
+    if (instance.color_source == ColorSource::Uniform) {
+      m["color_linear"] = vec_json(glm::dvec3(instance.color_linear));
+    }
+    meshes.push_back(std::move(m));
+  }
+  j["meshes"] = std::move(meshes);
+  j["triangles"] = scene.triangle_count();
+  j["vertices"] = total_vertices;
+  j["dropped_nonfinite_triangles"] = scene.dropped_nonfinite_triangles;
+  if (bounds.empty()) {
+    j["bounds"] = nullptr;
+  } else {
+    j["bounds"] = {{"min", vec_json(bounds.min)}, {"max", vec_json(bounds.max)}};
+  }
+  j["warnings"] = scene.warnings;
+  return j;
+}
+
+void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
+                     std::size_t total_vertices) {
+  const Camera& c = scene.camera;
+  std::cout << "file:        " << args.scene << '\n'
+            << "size:        " << scene.width << "x" << scene.height << '\n'
+            << "background:  " << vec_text(glm::dvec3(scene.background_linear)) << " (linear)\n"
+            << "camera:      eye " << vec_text(c.eye) << ", target " << vec_text(c.target)
+            << ", up " << vec_text(c.up) << '\n'
+            << "             fovy " << format_number(c.fovy_deg) << " deg, near "
+            << format_number(c.near) << ", far " << format_number(c.far) << '\n'
+            << "meshes:      " << scene.meshes.size() << '\n';
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const MeshInstance& instance = scene.meshes[i];
+    std::cout << "  [" << i << "] " << mesh_source(instance) << ": " << triangle_count(instance)
+              << " triangles, " << vertex_count(instance) << " vertices, colour "
+              << color_source_name(instance.color_source);
+    if (instance.color_source == ColorSource::Uniform) {
+      std::cout << " " << vec_text(glm::dvec3(instance.color_linear)) << " (linear)";
+    }
+    std::cout << '\n';
+  }
+  std::cout << "triangles:   " << scene.triangle_count();
+  if (scene.dropped_nonfinite_triangles > 0) {
+    std::cout << " (" << scene.dropped_nonfinite_triangles << " dropped: NaN/Inf coordinates)";
+  }
+  std::cout << '\n' << "vertices:    " << total_vertices << '\n';
+  if (bounds.empty()) {
+    std::cout << "bounds:      empty\n";
+  } else {
+    std::cout << "bounds:      min " << vec_text(bounds.min) << ", max " << vec_text(bounds.max)
+              << " (world)\n";
+  }
+  std::cout << "warnings:    " << (scene.warnings.empty() ? "none" : "") << '\n';
+  for (const std::string& warning : scene.warnings) std::cout << "  " << warning << '\n';
+}
+
+}  // namespace
+
+CLI::App* add_info_command(CLI::App& app, InfoArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "info",
+      "Load a scene and describe it: image size, background, camera, meshes (source, "
+      "triangles, vertices, colour source), totals, world-space bounding box and warnings.");
+  sub->add_option("scene", args.scene, "Scene file (JSON)")->required()->type_name("SCENE.json");
+  sub->add_flag("--json", args.json, "Print one JSON line instead of text");
+  return sub;
+}
+
+int run_info(const InfoArgs& args) {
+  const Scene scene = load_scene(args.scene);
+  const Bounds bounds = world_bounds(scene);
+  std::size_t total_vertices = 0;
+  for (const MeshInstance& instance : scene.meshes) total_vertices += vertex_count(instance);
+  if (args.json) {
+    std::cout << info_json(args, scene, bounds, total_vertices).dump() << '\n';
+  } else {
+    print_info_text(args, scene, bounds, total_vertices);
+  }
+  return 0;
+}
+
+}  // namespace covrast::cli

@@ -1,0 +1,185 @@
+// `covrast render`: loads a scene, renders it (optionally K times for timing), writes the PNG
+// (and optionally depth) atomically and optionally prints one JSON line of statistics.
+//
+// Everything that can be checked before rendering is checked first (mode, size, tile, output
+// paths, scene, --strict), so bad input fails fast with exit code 2 and creates no file.
+#include "commands.hpp"
+
+#include <covrast/error.hpp>
+#include <covrast/image.hpp>
+#include <covrast/renderer.hpp>
+#include <covrast/scene.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <charconv>
+#include <iostream>
+#include <string>
+#include <tuple>
+#include <vector>
+
+namespace covrast::cli {
+namespace {
+
+constexpr int kMinTile = 8;
+constexpr int kMaxTile = 256;
+constexpr int kMaxThreads = 4096;
+constexpr int kMaxRepeat = 1000;
+
+/// Parses "WxH" (decimal, each side 1..kMaxImageSide).
+std::pair<int, int> parse_size(const std::string& text) {
+  const auto fail = [&]() -> std::pair<int, int> {
+    throw InputError("--size: expected WxH with each side in 1.." + std::to_string(kMaxImageSide) +
+                     ", got '" + text + "'");
+  };
+  const std::size_t x = text.find_first_of("xX");
+  if (x == std::string::npos || x == 0 || x + 1 == text.size()) return fail();
+  const auto parse_side = [&](const char* first, const char* last) {
+    int value = 0;
+    const auto [end, error] = std::from_chars(first, last, value);
+    if (error != std::errc() || end != last || value < 1 || value > kMaxImageSide) fail();
+    return value;
+  };
+  const char* begin = text.data();
+  return {parse_side(begin, begin + x), parse_side(begin + x + 1, begin + text.size())};
+}
+
+/// Median of the per-frame values of one timing field; mean of the middle two for even K.
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  if (n == 0) return 0.0;
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+nlohmann::json stats_json(const RenderOptions& options, const RenderResult& last,
+                          const std::vector<RenderStats>& frames) {
+  const auto median_of = [&](double RenderStats::*field) {
+    std::vector<double> values;
+    values.reserve(frames.size());
+    for (const RenderStats& s : frames) values.push_back(s.*field);
+    return median(std::move(values));
+  };
+  const RenderStats& s = last.stats;
+  nlohmann::json j;
+  j["mode"] = to_string(options.mode);
+  j["width"] = last.color.width;
+  j["height"] = last.color.height;
+  j["threads"] = s.threads;
+  j["tile"] = s.tile;
+  j["triangles"] = {{"in", s.triangles_in},
+                    {"culled", s.triangles_culled},
+                    {"clipped", s.triangles_clipped},
+                    {"setup", s.triangles_setup},
+                    {"bin_entries", s.bin_entries}};
+  j["fragment_overflows"] = s.fragment_overflows;
+  j["scratch_bytes"] = s.scratch_bytes;
+  j["setup_ms"] = median_of(&RenderStats::setup_ms);
+  j["binning_ms"] = median_of(&RenderStats::binning_ms);
+  j["raster_ms"] = median_of(&RenderStats::raster_ms);
+  j["resolve_ms"] = median_of(&RenderStats::resolve_ms);
+  j["render_ms"] = median_of(&RenderStats::render_ms);
+  j["frames"] = frames.size();
+  return j;
+}
+
+}  // namespace
+
+CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
+  CLI::App* sub = app.add_subcommand(
+      "render",
+      "Render a JSON scene to a PNG (8-bit sRGB). The output is written atomically: on any "
+      "error nothing is created and an existing file is left untouched.");
+  sub->add_option("scene", args.scene, "Scene file (JSON, see docs/scene-format.md)")
+      ->required()
+      ->type_name("SCENE.json");
+  sub->add_option("-o,--output", args.output, "Output PNG file")->required()->type_name("OUT.png");
+  sub->add_option("--mode", args.mode,
+                  "Anti-aliasing mode: aliased, coverage (exact analytic area, default), "
+                  "coverage-blend, ssaa:N, ssaa-grid:N, msaa:K, reference")
+      ->capture_default_str()
+      ->type_name("MODE");
+  sub->add_option(
+         "--size", args.size,
+         "Image size, overriding the scene's (each side 1.." + std::to_string(kMaxImageSide) + ")")
+      ->type_name("WxH");
+  sub->add_option("--threads", args.threads, "Worker threads; 0 = all hardware threads")
+      ->check(CLI::Range(0, kMaxThreads))
+      ->capture_default_str()
+      ->type_name("N");
+  sub->add_option("--tile", args.tile, "Tile side in pixels: 8..256, a multiple of 8")
+      ->check(CLI::Validator(
+          [](std::string& text) -> std::string {
+            int value = 0;
+            const auto [end, error] =
+                std::from_chars(text.data(), text.data() + text.size(), value);
+            if (error != std::errc() || end != text.data() + text.size() || value < kMinTile ||
+                value > kMaxTile || value % 8 != 0) {
+              return "tile must be an integer in 8..256 and a multiple of 8, got '" + text + "'";
+            }
+            return {};
+          },
+          "8..256, multiple of 8"))
+      ->capture_default_str()
+      ->type_name("N");
+  sub->add_option("--depth", args.depth,
+                  "Also write window depth: .png = 16-bit greyscale (0 near .. 65535 far), "
+                  ".pfm = little-endian float PFM")
+      ->type_name("DEPTH.png|.pfm");
+  sub->add_flag("--stats", args.stats,
+                "Print one JSON line of statistics (counts, median stage times) to stdout");
+  sub->add_option("--repeat", args.repeat,
+                  "Render K frames and report the median frame time (1..1000)")
+      ->check(CLI::Range(1, kMaxRepeat))
+      ->capture_default_str()
+      ->type_name("K");
+  sub->add_flag("--strict", args.strict, "Treat scene warnings as errors (exit 2, no output)");
+  sub->add_flag("-q,--quiet", args.quiet, "Do not print the 'wrote ...' lines");
+  return sub;
+}
+
+int run_render(const RenderArgs& args) {
+  RenderOptions options;
+  options.mode = parse_render_mode(args.mode);
+  if (!args.size.empty()) std::tie(options.width, options.height) = parse_size(args.size);
+  options.threads = args.threads;
+  options.tile = args.tile;
+  options.want_depth = !args.depth.empty();
+
+  check_output_path(args.output, {".png"});
+  if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});
+
+  const Scene scene = load_scene(args.scene);
+  for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
+  if (args.strict && !scene.warnings.empty()) {
+    throw InputError(args.scene + ": " + std::to_string(scene.warnings.size()) +
+                     " warning(s), and --strict treats warnings as errors");
+  }
+
+  Renderer renderer(scene, options);
+  const bool show_progress = args.repeat > 1 && ::isatty(STDERR_FILENO) == 1;
+  std::vector<RenderStats> frames;
+  frames.reserve(std::size_t(args.repeat));
+  RenderResult result;
+  for (int frame = 0; frame < args.repeat; ++frame) {
+    if (show_progress) std::cerr << "\rframe " << frame + 1 << "/" << args.repeat << std::flush;
+    result = renderer.render_frame();
+    frames.push_back(result.stats);
+  }
+  if (show_progress) std::cerr << "\r\033[K" << std::flush;
+
+  write_png(result.color, args.output);
+  if (!args.quiet) std::cout << "wrote " << args.output << '\n';
+  if (options.want_depth) {
+    write_depth(result.depth, args.depth);
+    if (!args.quiet) std::cout << "wrote " << args.depth << '\n';
+  }
+  if (args.stats) std::cout << stats_json(options, result, frames).dump() << '\n';
+  std::cout.flush();
+  return 0;
+}
+
+}  // namespace covrast::cli

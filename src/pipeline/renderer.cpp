@@ -1,0 +1,251 @@
+// The pipeline: the only file that knows every stage and owns the oneTBB scheduling.
+//
+//   scene -> [setup: transform, clip, snap]  parallel over vertex blocks, then chunks
+//         -> [binning]                        parallel over chunks (counting sort per chunk)
+//         -> [raster + tile resolve]          parallel over tiles, per-thread scratch
+//         -> image
+//
+// Each phase is a parallel loop over a fixed decomposition (chunks of the global triangle
+// sequence, tiles of a fixed grid), and each task writes only its own output, so the image
+// is the same for every thread count.
+#include "binning/tile_bins.hpp"
+#include "geometry/frontend.hpp"
+#include "raster/tile_raster.hpp"
+
+#include <covrast/renderer.hpp>
+
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/enumerable_thread_specific.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include <algorithm>
+#include <charconv>
+#include <chrono>
+#include <string>
+
+namespace covrast {
+
+using detail::TriangleSetup;
+
+RenderMode parse_render_mode(std::string_view text) {
+  auto fail = [&]() -> RenderMode {
+    throw InputError("unknown mode '" + std::string(text) +
+                     "': expected aliased, coverage, coverage-blend, ssaa:N (N = 1..16), "
+                     "ssaa-grid:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
+  };
+  if (text == "aliased") return {ModeKind::Aliased, 1};
+  if (text == "coverage") return {ModeKind::Coverage, 1};
+  if (text == "coverage-blend") return {ModeKind::CoverageBlend, 1};
+  if (text == "reference") return {ModeKind::Reference, 64};
+  auto colon = text.find(':');
+  if (colon == std::string_view::npos) return fail();
+  std::string_view name = text.substr(0, colon), number = text.substr(colon + 1);
+  int n = 0;
+  auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), n);
+  if (ec != std::errc() || end != number.data() + number.size()) return fail();
+  if (name == "ssaa" || name == "ssaa-grid") {
+    if (n < 1 || n > 16) return fail();
+    return {name == "ssaa" ? ModeKind::Ssaa : ModeKind::SsaaGrid, n};
+  }
+  if (name == "msaa") {
+    if (n != 2 && n != 4 && n != 8 && n != 16) return fail();
+    return {ModeKind::Msaa, n};
+  }
+  return fail();
+}
+
+std::string to_string(const RenderMode& mode) {
+  switch (mode.kind) {
+    case ModeKind::Aliased:
+      return "aliased";
+    case ModeKind::Coverage:
+      return "coverage";
+    case ModeKind::CoverageBlend:
+      return "coverage-blend";
+    case ModeKind::Ssaa:
+      return "ssaa:" + std::to_string(mode.samples);
+    case ModeKind::SsaaGrid:
+      return "ssaa-grid:" + std::to_string(mode.samples);
+    case ModeKind::Msaa:
+      return "msaa:" + std::to_string(mode.samples);
+    case ModeKind::Reference:
+      return "reference";
+  }
+  return "?";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_between(Clock::time_point a, Clock::time_point b) {
+  return std::chrono::duration<double, std::milli>(b - a).count();
+}
+
+/// Vertices per transform task.
+constexpr std::size_t kVerticesPerBlock = 4096;
+
+}  // namespace
+
+struct Renderer::Impl {
+  const Scene& scene;
+  RenderOptions options;
+  int width_px;
+  int height_px;
+  int threads;
+  detail::TileGrid grid;
+  detail::GeometryFrontEnd front_end;
+  std::vector<std::vector<TriangleSetup>> chunk_triangles;
+  std::vector<detail::ChunkBins> chunk_bins;
+  tbb::task_arena arena;
+  tbb::enumerable_thread_specific<std::vector<std::uint32_t>> bin_scratch;
+  tbb::enumerable_thread_specific<std::unique_ptr<detail::TileRasterizer>> rasterizers;
+  tbb::enumerable_thread_specific<detail::SetupCounters> setup_counters;
+  tbb::enumerable_thread_specific<double> resolve_thread_ms;
+
+  Impl(const Scene& s, const RenderOptions& o, int w, int h, int t)
+      : scene(s),
+        options(o),
+        width_px(w),
+        height_px(h),
+        threads(t),
+        grid(w, h, o.tile),
+        front_end(s, w, h),
+        arena(t),
+        rasterizers([mode = o.mode, tile = o.tile] {
+          return detail::make_tile_rasterizer(mode, tile);
+        }) {
+    chunk_triangles.resize(front_end.chunk_count());
+    chunk_bins.resize(front_end.chunk_count());
+  }
+};
+
+Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
+  int w = options.width > 0 ? options.width : scene.width;
+  int h = options.height > 0 ? options.height : scene.height;
+  if (w < 1 || h < 1 || w > kMaxImageSide || h > kMaxImageSide) {
+    throw InputError("image size " + std::to_string(w) + "x" + std::to_string(h) +
+                     " out of range: each side must be 1.." + std::to_string(kMaxImageSide));
+  }
+  if (options.tile < 8 || options.tile > detail::kMaxTilePx || options.tile % 8 != 0) {
+    throw InputError("tile size " + std::to_string(options.tile) +
+                     " out of range: must be a multiple of 8 in 8.." +
+                     std::to_string(detail::kMaxTilePx));
+  }
+  if (options.threads < 0) throw InputError("thread count must be >= 0 (0 = all cores)");
+  int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+  // Fail early on modes that cannot be built.
+  detail::make_tile_rasterizer(options.mode, options.tile);
+  impl_ = std::make_unique<Impl>(scene, options, w, h, threads);
+}
+
+Renderer::~Renderer() = default;
+
+RenderResult Renderer::render_frame() {
+  Impl& im = *impl_;
+  RenderResult result;
+  result.color.width = im.width_px;
+  result.color.height = im.height_px;
+  result.color.rgb.assign(std::size_t(im.width_px) * im.height_px * 3, 0);
+  if (im.options.want_depth) {
+    result.depth.width = im.width_px;
+    result.depth.height = im.height_px;
+    result.depth.depth.assign(std::size_t(im.width_px) * im.height_px, 1.0f);
+  }
+  detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
+                             im.scene.background_linear};
+  for (auto& c : im.setup_counters) c = {};
+  for (auto& r : im.resolve_thread_ms) r = 0;
+
+  Clock::time_point t0, t1, t2, t3;
+  im.arena.execute([&] {
+    t0 = Clock::now();
+    // Setup, part 1: vertices to clip space, in fixed blocks per instance.
+    std::vector<std::pair<std::size_t, std::size_t>> blocks;
+    for (std::size_t i = 0; i < im.front_end.instance_count(); ++i) {
+      for (std::size_t v = 0; v < im.front_end.vertex_count(i); v += kVerticesPerBlock) {
+        blocks.emplace_back(i, v);
+      }
+    }
+    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
+      auto [instance, begin] = blocks[b];
+      std::size_t end = std::min(begin + kVerticesPerBlock, im.front_end.vertex_count(instance));
+      im.front_end.transform_vertices(instance, begin, end);
+    });
+    // Setup, part 2: clip, snap and set up each chunk of triangles.
+    tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
+      im.chunk_triangles[c].clear();
+      im.front_end.setup_chunk(c, im.chunk_triangles[c], im.setup_counters.local());
+    });
+    t1 = Clock::now();
+    tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
+      detail::bin_chunk(im.grid, im.chunk_triangles[c], im.chunk_bins[c], im.bin_scratch.local());
+    });
+    t2 = Clock::now();
+    tbb::parallel_for(
+        tbb::blocked_range<int>(0, im.grid.tile_count(), 1), [&](const tbb::blocked_range<int>& r) {
+          detail::TileRasterizer& raster = *im.rasterizers.local();
+          for (int tile = r.begin(); tile < r.end(); ++tile) {
+            raster.begin_tile(im.grid.tile_rect(tile), target);
+            for (std::size_t c = 0; c < im.chunk_bins.size(); ++c) {
+              const auto& tris = im.chunk_triangles[c];
+              for (std::uint32_t i : im.chunk_bins[c].tile(tile)) raster.draw(tris[i]);
+            }
+            Clock::time_point r0 = Clock::now();
+            raster.end_tile(target);
+            im.resolve_thread_ms.local() += ms_between(r0, Clock::now());
+          }
+        });
+    t3 = Clock::now();
+  });
+
+  RenderStats& st = result.stats;
+  st.triangles_in = im.front_end.triangle_count();
+  for (const auto& c : im.setup_counters) {
+    st.triangles_culled += c.culled;
+    st.triangles_clipped += c.clipped;
+  }
+  for (const auto& tris : im.chunk_triangles) st.triangles_setup += tris.size();
+  for (const auto& b : im.chunk_bins) st.bin_entries += b.triangle_index.size();
+  double resolve_total = 0;
+  for (double r : im.resolve_thread_ms) resolve_total += r;
+  for (const auto& r : im.rasterizers) {
+    st.scratch_bytes += r->scratch_bytes();
+    st.fragment_overflows += r->overflow_count();
+  }
+  st.setup_ms = ms_between(t0, t1);
+  st.binning_ms = ms_between(t1, t2);
+  // The tile pass interleaves raster and resolve per tile; the resolve share is the summed
+  // per-thread resolve time spread over the threads that ran.
+  st.resolve_ms = resolve_total / std::max(1, im.threads);
+  st.raster_ms = std::max(0.0, ms_between(t2, t3) - st.resolve_ms);
+  st.render_ms = ms_between(t0, t3);
+  st.threads = im.threads;
+  st.tile = im.options.tile;
+  return result;
+}
+
+RenderResult render(const Scene& scene, const RenderOptions& options) {
+  Renderer renderer(scene, options);
+  return renderer.render_frame();
+}
+
+namespace detail {
+
+std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int tile_px) {
+  switch (mode.kind) {
+    case ModeKind::Aliased:
+      return make_aliased_rasterizer(tile_px);
+    case ModeKind::Coverage:
+      return make_coverage_rasterizer(tile_px, false);
+    case ModeKind::CoverageBlend:
+      return make_coverage_rasterizer(tile_px, true);
+    default:
+      break;
+  }
+  throw InputError("mode '" + to_string(mode) + "' is not available in this build yet");
+}
+
+}  // namespace detail
+}  // namespace covrast

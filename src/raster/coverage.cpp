@@ -1,0 +1,158 @@
+// Raster stage, coverage modes: per triangle, the coverage kernel fills the triangle's
+// span of a tile-local alpha plane (8.8 coverage per pixel, column group by column group:
+// a top partial run, an interior run of full pixels with no per-pixel math, a bottom
+// partial run); then each covered pixel goes to
+//  - coverage:       the A-buffer (resolve/abuffer.hpp), which resolves it without seams;
+//  - coverage-blend: the literal seed, alpha-blended over the frame buffer with one depth
+//                    per pixel (kept to show what the A-buffer fixes).
+#include "raster/coverage_kernel.hpp"
+#include "raster/shading.hpp"
+#include "raster/tile_raster.hpp"
+#include "resolve/abuffer.hpp"
+#include "resolve/srgb8.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <limits>
+#include <memory>
+#include <vector>
+
+namespace covrast::detail {
+namespace {
+
+class CoverageRasterizer final : public TileRasterizer {
+public:
+  CoverageRasterizer(int tile_px, bool blend)
+      : tile_px_(tile_px),
+        blend_(blend),
+        plane_stride_(std::size_t(tile_px) + kColumnGroup),
+        plane_(std::size_t(tile_px) * plane_stride_),
+        columns_(std::make_unique<CoverageColumns>()),
+        abuffer_(blend ? 1 : tile_px) {
+    if (blend_) {
+      color_.resize(std::size_t(tile_px) * tile_px);
+      depth_.resize(std::size_t(tile_px) * tile_px);
+    }
+  }
+
+  void begin_tile(const PixelRect& rect, const FrameTarget& target) override {
+    rect_ = rect;
+    background_ = target.background_linear;
+    if (blend_) {
+      std::fill(depth_.begin(), depth_.end(), std::numeric_limits<float>::infinity());
+      std::fill(color_.begin(), color_.end(), glm::vec3(-1.0f));
+    } else {
+      abuffer_.begin_tile(rect);
+    }
+  }
+
+  void draw(const TriangleSetup& t) override {
+    const PixelRect r = intersect(touched_pixels(t), rect_);
+    if (r.empty()) return;
+    const CoverageTriangle tri = make_coverage_triangle(t);
+    CoverageColumns& cols = *columns_;
+    for (int g = r.x0; g < r.x1; g += kColumnGroup) {
+      // Set up the group's columns; lanes past the span get zero width.
+      const int lanes = std::min(kColumnGroup, r.x1 - g);
+      int first = INT_MAX, end = INT_MIN, interior_begin = INT_MIN, interior_end = INT_MAX;
+      for (int lane = 0; lane < kColumnGroup; ++lane) {
+        if (lane >= lanes) {
+          for (int e = 0; e < 3; ++e) {
+            cols.t_left[e][lane] = cols.t_right[e][lane] = 0.0f;
+            cols.width_q[e][lane] = cols.slope_q[e][lane] = 0.0f;
+            cols.base_row[e][lane] = 0;
+          }
+          continue;
+        }
+        ColumnRows rows = setup_column(tri, g + lane, cols, lane);
+        if (rows.first >= rows.end) continue;
+        first = std::min(first, rows.first);
+        end = std::max(end, rows.end);
+        interior_begin = std::max(interior_begin, rows.interior_begin);
+        interior_end = std::min(interior_end, rows.interior_end);
+      }
+      first = std::max(first, r.y0);
+      end = std::min(end, r.y1);
+      if (first >= end) continue;
+      interior_begin = std::clamp(interior_begin, first, end);
+      interior_end = std::clamp(interior_end, interior_begin, end);
+      std::uint16_t* out = plane_.data() + std::size_t(first - rect_.y0) * plane_stride_;
+      // Top partial run, interior run, bottom partial run.
+      kernel_(cols, 0, first, interior_begin, tri.sign, out, plane_stride_);
+      for (int y = interior_begin; y < interior_end; ++y) {
+        std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
+        for (int lane = 0; lane < kColumnGroup; ++lane) row[lane] = std::uint16_t(cols.width_q[0][lane]);
+      }
+      kernel_(cols, 0, interior_end, end,
+              tri.sign, plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_,
+              plane_stride_);
+      consume(t, g, lanes, first, end);
+    }
+  }
+
+  void end_tile(const FrameTarget& target) override {
+    if (!blend_) {
+      abuffer_.resolve(target);
+      return;
+    }
+    for (auto& c : color_) {
+      if (c.r < 0.0f) c = target.background_linear;
+    }
+    write_tile(target, rect_, color_.data(), depth_.data(), tile_px_);
+  }
+
+  std::size_t scratch_bytes() const override {
+    return plane_.size() * sizeof(std::uint16_t) + sizeof(CoverageColumns) +
+           color_.size() * sizeof(glm::vec3) + depth_.size() * sizeof(float) +
+           abuffer_.scratch_bytes();
+  }
+  std::uint64_t overflow_count() const override { return abuffer_.overflow_count(); }
+
+  /// Kernel used for the partial runs; tests swap in the scalar twin.
+  CoverageRowsFn kernel_ = coverage_rows_simd;
+
+private:
+  /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
+  void consume(const TriangleSetup& t, int g, int lanes, int first, int end) {
+    for (int y = first; y < end; ++y) {
+      const std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
+      for (int lane = 0; lane < lanes; ++lane) {
+        const std::uint32_t coverage = row[lane];
+        if (coverage == 0) continue;
+        const int x = g + lane;
+        if (!blend_) {
+          abuffer_.add(x, y, &t, coverage);
+          continue;
+        }
+        // The seed's compositing: one depth per pixel, blend with the 8-bit alpha.
+        const double cx = x + 0.5, cy = y + 0.5;
+        const std::size_t i = std::size_t(y - rect_.y0) * tile_px_ + (x - rect_.x0);
+        const float z = float(t.depth_at(cx, cy));
+        if (!(z < depth_[i])) continue;
+        const float alpha = coverage_to_alpha8(coverage) / 255.0f;
+        glm::vec3 dst = color_[i].r < 0.0f ? background_ : color_[i];
+        color_[i] = alpha * shade(t, cx, cy, true) + (1.0f - alpha) * dst;
+        depth_[i] = z;
+      }
+    }
+  }
+
+  int tile_px_;
+  bool blend_;
+  std::size_t plane_stride_;
+  PixelRect rect_;
+  std::vector<std::uint16_t> plane_;  ///< the alpha plane: 8.8 coverage per pixel of the span
+  std::unique_ptr<CoverageColumns> columns_;
+  ABufferTile abuffer_;
+  std::vector<glm::vec3> color_;  ///< coverage-blend: linear colour, r < 0 = background
+  std::vector<float> depth_;      ///< coverage-blend: one depth per pixel
+  glm::vec3 background_{0.0f};
+};
+
+}  // namespace
+
+std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend) {
+  return std::make_unique<CoverageRasterizer>(tile_px, blend);
+}
+
+}  // namespace covrast::detail

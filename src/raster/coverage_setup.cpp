@@ -1,0 +1,114 @@
+// Raster stage, coverage mode: per-triangle and per-column set-up of the kernel's inputs,
+// in double precision from the snapped vertices; see coverage_kernel.hpp for the formula.
+#include "raster/coverage_kernel.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+namespace covrast::detail {
+namespace {
+
+CoverageEdge make_edge(double xa, double ya, double xb, double yb) {
+  // Canonical direction (left to right, then top to bottom) so that both triangles of a
+  // shared edge compute every term from the same numbers in the same order.
+  if (xb < xa || (xb == xa && yb < ya)) {
+    std::swap(xa, xb);
+    std::swap(ya, yb);
+  }
+  CoverageEdge e{xa, ya, xb, yb, 0.0};
+  if (xb > xa) e.slope = (yb - ya) / (xb - xa);
+  return e;
+}
+
+}  // namespace
+
+CoverageTriangle make_coverage_triangle(const TriangleSetup& t) {
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int i, int j) {
+    return t.x_fx8[i] < t.x_fx8[j] || (t.x_fx8[i] == t.x_fx8[j] && t.y_fx8[i] < t.y_fx8[j]);
+  });
+  const std::int64_t xa = t.x_fx8[order[0]], ya = t.y_fx8[order[0]];
+  const std::int64_t xb = t.x_fx8[order[1]], yb = t.y_fx8[order[1]];
+  const std::int64_t xc = t.x_fx8[order[2]], yc = t.y_fx8[order[2]];
+  const double s = 1.0 / kSubpixelOne;
+  CoverageTriangle tri;
+  tri.edge[0] = make_edge(xa * s, ya * s, xc * s, yc * s);
+  tri.edge[1] = make_edge(xa * s, ya * s, xb * s, yb * s);
+  tri.edge[2] = make_edge(xb * s, yb * s, xc * s, yc * s);
+  // b below the line ac (larger y) <=> cross(c - a, b - a) > 0; exact in int64.
+  std::int64_t cross = (xc - xa) * (yb - ya) - (yc - ya) * (xb - xa);
+  tri.sign = cross > 0 ? -1 : +1;
+  tri.x_min = xa * s;
+  tri.x_max = xc * s;
+  return tri;
+}
+
+ColumnRows setup_column(const CoverageTriangle& tri, int col, CoverageColumns& columns, int lane) {
+  ColumnRows rows{INT_MAX, INT_MIN, INT_MIN, INT_MAX};
+  const double cl = col, cr = col + 1.0;
+  for (int e = 0; e < 3; ++e) {
+    const CoverageEdge& edge = tri.edge[e];
+    const double xl = std::max(cl, edge.x0), xr = std::min(cr, edge.x1);
+    if (!(xl < xr)) {
+      columns.t_left[e][lane] = 0.0f;
+      columns.t_right[e][lane] = 0.0f;
+      columns.width_q[e][lane] = 0.0f;
+      columns.slope_q[e][lane] = 0.0f;
+      columns.base_row[e][lane] = 0;
+      continue;
+    }
+    // Exact endpoints where the piece ends at a vertex; the line equation elsewhere.
+    const double yl = xl == edge.x0 ? edge.y0 : edge.y0 + (xl - edge.x0) * edge.slope;
+    const double yr = xr == edge.x1 ? edge.y1 : edge.y0 + (xr - edge.x0) * edge.slope;
+    const double ymin = std::min(yl, yr), ymax = std::max(yl, yr);
+    const double base = std::floor(ymin);
+    const float tl = float(yl - base), tr = float(yr - base);
+    const float wq = float(kCoverageOne * (xr - xl));  // exact: xr - xl is a multiple of 1/256
+    columns.t_left[e][lane] = tl;
+    columns.t_right[e][lane] = tr;
+    columns.width_q[e][lane] = wq;
+    columns.slope_q[e][lane] = std::fabs(tr - tl) >= kFlatEdgeEps ? wq / (tr - tl) : 0.0f;
+    columns.base_row[e][lane] = int(base);
+    const int band_first = int(base), band_end = int(std::ceil(ymax));
+    const bool top = (e == 0) == (tri.sign < 0);  // ac is top when sign < 0
+    rows.first = std::min(rows.first, band_first);
+    rows.end = std::max(rows.end, std::max(band_end, band_first + 1));
+    if (top) {
+      rows.interior_begin = std::max(rows.interior_begin, band_end);
+    } else {
+      rows.interior_end = std::min(rows.interior_end, band_first);
+    }
+  }
+  if (rows.first > rows.end) rows = ColumnRows{0, 0, 0, 0};
+  if (rows.interior_begin > rows.interior_end) rows.interior_end = rows.interior_begin;
+  return rows;
+}
+
+void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin, int row_end,
+                          int sign, std::uint16_t* out, std::size_t stride) {
+  for (int r = row_begin; r < row_end; ++r, out += stride) {
+    for (int c = col; c < col + kColumnGroup; ++c) {
+      std::int32_t q[3];
+      for (int e = 0; e < 3; ++e) {
+        const float k = float(r - columns.base_row[e][c]);
+        const float a = columns.t_left[e][c] - k;
+        const float b = columns.t_right[e][c] - k;
+        const float lo = std::min(a, b), hi = std::max(a, b);
+        const bool simple = hi <= 0.0f || lo >= 1.0f || (lo >= 0.0f && hi <= 1.0f) ||
+                            (hi - lo) < kFlatEdgeEps;
+        const float mid = std::min(std::max((a + b) * 0.5f, 0.0f), 1.0f);
+        const float ca = std::min(std::max(a, 0.0f), 1.0f);
+        const float cb = std::min(std::max(b, 0.0f), 1.0f);
+        const float ha = ca * ca * 0.5f + std::max(a - 1.0f, 0.0f);
+        const float hb = cb * cb * 0.5f + std::max(b - 1.0f, 0.0f);
+        const float area = simple ? columns.width_q[e][c] * mid : (hb - ha) * columns.slope_q[e][c];
+        q[e] = std::int32_t(std::nearbyint(area));
+      }
+      std::int32_t cov = sign * (q[0] - q[1] - q[2]);
+      out[c - col] = std::uint16_t(std::clamp(cov, 0, kCoverageOne));
+    }
+  }
+}
+
+}  // namespace covrast::detail

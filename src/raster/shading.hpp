@@ -1,0 +1,42 @@
+// Shading shared by every raster mode: flat, unlit colour, perspective-correct
+// interpolation of vertex colours in linear light.
+#pragma once
+
+#include "geometry/triangle_setup.hpp"
+
+#include <algorithm>
+
+namespace covrast::detail {
+
+/// Colour of `t` at (x_px, y_px). With `clamp_inside`, barycentric weights are clamped to
+/// [0, 1] and renormalised, so a point outside the triangle takes the colour of the
+/// nearest part of it and colours never extrapolate.
+///   lambda_i = E_jk(p) / E_jk(v_i)   (screen-space barycentrics)
+///   mu_i = lambda_i / w_i / sum_j (lambda_j / w_j)   (perspective-correct)
+inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
+  if (t.flat_color) return t.color[0];
+  const double s = 1.0 / kSubpixelOne;
+  double x0 = t.x_fx8[0] * s, y0 = t.y_fx8[0] * s;
+  double x1 = t.x_fx8[1] * s, y1 = t.y_fx8[1] * s;
+  double x2 = t.x_fx8[2] * s, y2 = t.y_fx8[2] * s;
+  double area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
+  double l0 = ((x2 - x1) * (y_px - y1) - (y2 - y1) * (x_px - x1)) / area;
+  double l1 = ((x0 - x2) * (y_px - y2) - (y0 - y2) * (x_px - x2)) / area;
+  double l2 = ((x1 - x0) * (y_px - y0) - (y1 - y0) * (x_px - x0)) / area;
+  if (clamp_inside) {
+    l0 = std::max(l0, 0.0);
+    l1 = std::max(l1, 0.0);
+    l2 = std::max(l2, 0.0);
+  }
+  double p0 = l0 * t.inv_w[0], p1 = l1 * t.inv_w[1], p2 = l2 * t.inv_w[2];
+  double sum = p0 + p1 + p2;
+  if (!(sum > 0.0)) return t.color[0];
+  p0 /= sum;
+  p1 /= sum;
+  p2 /= sum;
+  return glm::vec3(float(p0 * t.color[0].r + p1 * t.color[1].r + p2 * t.color[2].r),
+                   float(p0 * t.color[0].g + p1 * t.color[1].g + p2 * t.color[2].g),
+                   float(p0 * t.color[0].b + p1 * t.color[1].b + p2 * t.color[2].b));
+}
+
+}  // namespace covrast::detail

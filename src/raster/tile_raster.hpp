@@ -1,0 +1,47 @@
+// Raster stage interface: one rasterizer per mode, one instance per worker thread.
+//
+// The pipeline hands a tile to a rasterizer as begin_tile, then every binned triangle in
+// draw order (one virtual call per triangle, never per pixel), then end_tile, which
+// resolves the tile and writes its final 8-bit sRGB pixels into the frame. Everything a
+// rasterizer keeps is tile-local scratch, reused from tile to tile.
+#pragma once
+
+#include "geometry/triangle_setup.hpp"
+
+#include <covrast/image.hpp>
+#include <covrast/renderer.hpp>
+
+#include <cstdint>
+#include <memory>
+
+namespace covrast::detail {
+
+struct FrameTarget {
+  Image* color = nullptr;
+  DepthImage* depth = nullptr;  ///< null when no depth output is wanted
+  glm::vec3 background_linear{0.0f};
+};
+
+class TileRasterizer {
+public:
+  virtual ~TileRasterizer() = default;
+  virtual void begin_tile(const PixelRect& rect, const FrameTarget& target) = 0;
+  virtual void draw(const TriangleSetup& triangle) = 0;
+  /// Resolves the tile and writes it into `target` (only this tile's pixels).
+  virtual void end_tile(const FrameTarget& target) = 0;
+  /// Bytes of tile-local scratch this instance holds now.
+  virtual std::size_t scratch_bytes() const = 0;
+  /// Fragments merged or dropped because a pixel's list was full (coverage mode).
+  virtual std::uint64_t overflow_count() const { return 0; }
+};
+
+/// Largest tile side the rasterizers accept [pixels].
+inline constexpr int kMaxTilePx = 256;
+
+std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int tile_px);
+
+// Factories of the individual modes (raster/<mode>.cpp).
+std::unique_ptr<TileRasterizer> make_aliased_rasterizer(int tile_px);
+std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend);
+
+}  // namespace covrast::detail

@@ -1,0 +1,68 @@
+// Resolve stage, coverage mode: a per-tile A-buffer (Carpenter 1984) whose weights are the
+// exact analytic areas of the coverage kernel.
+//
+// Fully covered pixels take a fast path: an ordinary depth test against one opaque
+// surface per pixel (depth planes compared at the pixel's four corners, so a plane that
+// crosses the opaque one inside the pixel is kept as a fragment instead). Partly covered
+// pixels keep a short list of fragments (triangle, 8.8 coverage), resolved front to back
+// when the tile is done:
+//  - one surface only (one mesh instance, one facing) in front of the opaque surface:
+//    colour = sum(coverage_i * colour_i) + (1 - sum coverage) * behind; adjacent triangles of
+//    a tessellation add to exactly one pixel, so no background leaks through seams;
+//  - otherwise, per 8x8 sub-pixel samples from the same fixed-point edge functions, with
+//    per-sample depth from each triangle's plane: a fragment's weight is its coverage times
+//    the share of its samples where it is the nearest; what remains goes to the opaque
+//    surface behind, or the background.
+#pragma once
+
+#include "geometry/triangle_setup.hpp"
+#include "raster/tile_raster.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace covrast::detail {
+
+/// Fragments one pixel keeps. Beyond it: drop fragments hidden by the opaque surface, then
+/// merge into a fragment of the same surface and facing (coverages add, the older
+/// triangle stands for both), else drop the farthest. Counted in overflow_count().
+inline constexpr int kMaxFragmentsPerPixel = 16;
+
+class ABufferTile {
+public:
+  explicit ABufferTile(int tile_px);
+
+  void begin_tile(const PixelRect& rect);
+  /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile.
+  void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage);
+  /// Resolves every pixel and writes the tile into the frame.
+  void resolve(const FrameTarget& target);
+
+  std::size_t scratch_bytes() const;
+  std::uint64_t overflow_count() const { return overflows_; }
+
+private:
+  struct Fragment {
+    const TriangleSetup* triangle;
+    std::uint32_t next;      ///< index into pool_, or kEnd
+    std::uint32_t coverage;  ///< 8.8, 1/255 units
+  };
+  static constexpr std::uint32_t kEnd = 0xffffffffu;
+
+  void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                    std::uint32_t coverage);
+  glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
+
+  int stride_;
+  PixelRect rect_;
+  std::vector<const TriangleSetup*> opaque_;  ///< per pixel, null = background
+  std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
+  std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
+  std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
+  std::vector<Fragment> pool_;
+  std::vector<glm::vec3> color_;  ///< resolved linear colour
+  std::vector<float> depth_;      ///< resolved window depth
+  std::uint64_t overflows_ = 0;
+};
+
+}  // namespace covrast::detail

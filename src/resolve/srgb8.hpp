@@ -1,0 +1,22 @@
+// Resolve stage: linear light to 8-bit sRGB, exactly round(255 * srgb(x)), and the
+// copy-out of a finished tile into the frame.
+#pragma once
+
+#include "geometry/triangle_setup.hpp"
+#include "raster/tile_raster.hpp"
+
+#include <cstdint>
+#include <span>
+
+namespace covrast::detail {
+
+/// round(255 * linear_to_srgb(x)) for x in [0, 1] (clamped), by binary search over the
+/// 255 linear values where the 8-bit code changes: exact, and identical on every path.
+std::uint8_t encode_srgb8(float linear);
+
+/// Writes a tile's linear colours (row stride `stride` pixels) as 8-bit sRGB, and, when the
+/// target wants depth, its window depths, into the frame.
+void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec3* linear,
+                const float* depth, int stride);
+
+}  // namespace covrast::detail

@@ -1,0 +1,44 @@
+// Colour helpers of the scene format: the sRGB transfer function (IEC 61966-2-1) used to turn
+// the sRGB display values of scene files into linear light, and the per_triangle debug colour.
+#include <covrast/scene.hpp>
+
+#include <cmath>
+
+namespace covrast {
+
+float srgb_to_linear(float encoded) {
+  // !(x > 0) also maps NaN to 0, so no NaN ever leaves the loader as a colour.
+  if (!(encoded > 0.0f)) return 0.0f;
+  if (encoded >= 1.0f) return 1.0f;
+  const double c = encoded;
+  // c <= 0.04045: c / 12.92, else ((c + 0.055) / 1.055)^2.4
+  const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  return static_cast<float>(linear);
+}
+
+float linear_to_srgb(float linear) {
+  if (!(linear > 0.0f)) return 0.0f;
+  if (linear >= 1.0f) return 1.0f;
+  const double c = linear;
+  // c <= 0.0031308: 12.92 c, else 1.055 c^(1/2.4) - 0.055
+  const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  return static_cast<float>(encoded);
+}
+
+std::uint32_t lowbias32(std::uint32_t x) {
+  // Chris Wellons' lowbias32 integer hash; all arithmetic is modulo 2^32.
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+glm::vec3 per_triangle_color_srgb(std::uint32_t global_triangle_index) {
+  const std::uint32_t h = lowbias32(global_triangle_index);
+  return {static_cast<float>(h & 255u) / 255.0f, static_cast<float>((h >> 8) & 255u) / 255.0f,
+          static_cast<float>((h >> 16) & 255u) / 255.0f};
+}
+
+}  // namespace covrast

@@ -1,0 +1,476 @@
+// glTF 2.0 reader (.gltf with embedded or external buffers, .glb) on top of tinygltf. Collects
+// every mode-TRIANGLES primitive of every mesh reachable from the default scene (scene 0 when
+// none is marked, every root node when the file has no scene at all), bakes the node transforms
+// (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into colors_linear.
+// glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
+// bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
+#include "scene/scene_internal.hpp"
+
+#include <tiny_gltf.h>
+
+#include <algorithm>
+#include <bit>
+#include <climits>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <vector>
+
+namespace covrast::detail {
+namespace {
+
+static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
+
+constexpr std::size_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
+/// Accessors without a bufferView are all zeros (plus sparse values): cap what they allocate.
+constexpr std::size_t kMaxUnbackedElements = std::size_t{1} << 26;
+
+[[noreturn]] void fail(const std::string& name, const std::string& message) {
+  throw InputError(name + ": " + message);
+}
+
+/// tinygltf's messages can span several lines; ours are one line.
+std::string one_line(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
+    text.pop_back();
+  }
+  std::string out;
+  for (const char c : text) {
+    if (c == '\n') {
+      out += "; ";
+    } else if (c != '\r') {
+      out += c;
+    }
+  }
+  return out;
+}
+
+int component_size_bytes(int component_type) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
+      return 1;
+    case TINYGLTF_COMPONENT_TYPE_SHORT:
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
+      return 2;
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+    case TINYGLTF_COMPONENT_TYPE_FLOAT:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+int component_count(int type) {
+  switch (type) {
+    case TINYGLTF_TYPE_SCALAR:
+      return 1;
+    case TINYGLTF_TYPE_VEC2:
+      return 2;
+    case TINYGLTF_TYPE_VEC3:
+      return 3;
+    case TINYGLTF_TYPE_VEC4:
+      return 4;
+    default:
+      return 0;
+  }
+}
+
+template <typename T>
+T load(const unsigned char* bytes) {
+  T value;
+  std::memcpy(&value, bytes, sizeof value);
+  return value;
+}
+
+/// One component; normalized integers map to [0, 1] or [-1, 1] (glTF 2.0 spec, 3.11).
+double read_component(const unsigned char* bytes, int component_type, bool normalized) {
+  switch (component_type) {
+    case TINYGLTF_COMPONENT_TYPE_BYTE: {
+      const double v = load<std::int8_t>(bytes);
+      return normalized ? std::max(v / 127.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
+      const double v = load<std::uint8_t>(bytes);
+      return normalized ? v / 255.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_SHORT: {
+      const double v = load<std::int16_t>(bytes);
+      return normalized ? std::max(v / 32767.0, -1.0) : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
+      const double v = load<std::uint16_t>(bytes);
+      return normalized ? v / 65535.0 : v;
+    }
+    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
+      return load<std::uint32_t>(bytes);
+    default:
+      return load<float>(bytes);
+  }
+}
+
+struct Reader {
+  const tinygltf::Model& model;
+  const std::string& name;
+
+  /// Reads `count` elements of `components` components from a buffer view into `out`.
+  /// `strided`: honour the view's byteStride (vertex attributes), else tightly packed.
+  void read_view(const std::string& what, int view_index, std::size_t byte_offset,
+                 std::size_t count, int component_type, int components, bool normalized,
+                 bool strided, double* out) const {
+    if (view_index < 0 || static_cast<std::size_t>(view_index) >= model.bufferViews.size()) {
+      fail(name, what + ": bufferView " + std::to_string(view_index) + " does not exist");
+    }
+    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(view_index)];
+    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size()) {
+      fail(name, what + ": buffer " + std::to_string(view.buffer) + " does not exist");
+    }
+    const std::vector<unsigned char>& data =
+        model.buffers[static_cast<std::size_t>(view.buffer)].data;
+    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
+      fail(name, what + ": bufferView " + std::to_string(view_index) + " exceeds its buffer");
+    }
+    if (count == 0) return;
+    const std::size_t element_bytes =
+        static_cast<std::size_t>(component_size_bytes(component_type)) *
+        static_cast<std::size_t>(components);
+    const std::size_t stride = strided && view.byteStride != 0 ? view.byteStride : element_bytes;
+    if (stride < element_bytes) fail(name, what + ": byteStride smaller than one element");
+    // Last element must end inside the view: offset + stride * (count - 1) + element <= length.
+    if (byte_offset > view.byteLength || view.byteLength - byte_offset < element_bytes ||
+        count - 1 > (view.byteLength - byte_offset - element_bytes) / stride) {
+      fail(name,
+           what + ": accessor reads past the end of bufferView " + std::to_string(view_index));
+    }
+    const unsigned char* base = data.data() + view.byteOffset + byte_offset;
+    const std::size_t size = static_cast<std::size_t>(component_size_bytes(component_type));
+    for (std::size_t i = 0; i < count; ++i) {
+      for (int c = 0; c < components; ++c) {
+        out[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
+            read_component(base + i * stride + static_cast<std::size_t>(c) * size, component_type,
+                           normalized);
+      }
+    }
+  }
+
+  /// Reads a whole accessor (including sparse substitution) as doubles, `components` per
+  /// element; `components` receives the element width.
+  std::vector<double> read_accessor(const std::string& what, int accessor_index,
+                                    int& components) const {
+    if (accessor_index < 0 || static_cast<std::size_t>(accessor_index) >= model.accessors.size()) {
+      fail(name, what + ": accessor " + std::to_string(accessor_index) + " does not exist");
+    }
+    const tinygltf::Accessor& accessor = model.accessors[static_cast<std::size_t>(accessor_index)];
+    components = component_count(accessor.type);
+    if (components == 0 || component_size_bytes(accessor.componentType) == 0) {
+      fail(name, what + ": unsupported accessor type or component type");
+    }
+    const auto width = static_cast<std::size_t>(components);
+    if (accessor.bufferView < 0 && accessor.count > kMaxUnbackedElements) {
+      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
+    }
+    if (accessor.bufferView >= 0 && accessor.count > kMaxVertices) {
+      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
+    }
+    std::vector<double> values;
+    if (accessor.bufferView >= 0) {
+      // Validate the view before allocating: it must hold count elements of >= 1 byte.
+      read_view(what, accessor.bufferView, accessor.byteOffset, 0, accessor.componentType,
+                components, accessor.normalized, true, nullptr);
+      const tinygltf::BufferView& view =
+          model.bufferViews[static_cast<std::size_t>(accessor.bufferView)];
+      if (accessor.count > view.byteLength) {
+        fail(name, what + ": accessor reads past the end of bufferView " +
+                       std::to_string(accessor.bufferView));
+      }
+      values.resize(accessor.count * width);
+      read_view(what, accessor.bufferView, accessor.byteOffset, accessor.count,
+                accessor.componentType, components, accessor.normalized, true, values.data());
+    } else {
+      values.assign(accessor.count * width, 0.0);
+    }
+    if (accessor.sparse.isSparse) {
+      const auto& sparse = accessor.sparse;
+      if (sparse.count < 0 || static_cast<std::size_t>(sparse.count) > accessor.count ||
+          sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0) {
+        fail(name, what + ": bad sparse accessor");
+      }
+      const int index_type = sparse.indices.componentType;
+      if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
+        fail(name, what + ": bad sparse index component type");
+      }
+      const auto sparse_count = static_cast<std::size_t>(sparse.count);
+      std::vector<double> targets(sparse_count);
+      std::vector<double> replacements(sparse_count * width);
+      read_view(what + " (sparse indices)", sparse.indices.bufferView,
+                static_cast<std::size_t>(sparse.indices.byteOffset), sparse_count, index_type, 1,
+                false, false, targets.data());
+      read_view(what + " (sparse values)", sparse.values.bufferView,
+                static_cast<std::size_t>(sparse.values.byteOffset), sparse_count,
+                accessor.componentType, components, accessor.normalized, false,
+                replacements.data());
+      for (std::size_t i = 0; i < sparse_count; ++i) {
+        const auto target = static_cast<std::size_t>(targets[i]);
+        if (target >= accessor.count) fail(name, what + ": sparse index out of range");
+        std::copy_n(replacements.begin() + static_cast<std::ptrdiff_t>(i * width), width,
+                    values.begin() + static_cast<std::ptrdiff_t>(target * width));
+      }
+    }
+    return values;
+  }
+};
+
+/// Node-local transform: the matrix when given (column-major, like GLM), else T * R * S.
+glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, int node_index) {
+  const std::string what = "node " + std::to_string(node_index);
+  if (!node.matrix.empty()) {
+    if (node.matrix.size() != 16) fail(name, what + ": matrix needs 16 numbers");
+    glm::dmat4 m(1.0);
+    for (int col = 0; col < 4; ++col) {
+      for (int row = 0; row < 4; ++row)
+        m[col][row] = node.matrix[static_cast<std::size_t>(col * 4 + row)];
+    }
+    return m;
+  }
+  if ((!node.translation.empty() && node.translation.size() != 3) ||
+      (!node.rotation.empty() && node.rotation.size() != 4) ||
+      (!node.scale.empty() && node.scale.size() != 3)) {
+    fail(name, what + ": translation/scale need 3 numbers, rotation 4");
+  }
+  glm::dmat4 t(1.0);
+  if (!node.translation.empty()) {
+    t[3] = glm::dvec4(node.translation[0], node.translation[1], node.translation[2], 1.0);
+  }
+  glm::dmat4 r(1.0);
+  if (!node.rotation.empty()) {
+    // Unit quaternion (x, y, z, w) -> rotation matrix; normalised first for robustness.
+    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
+    const double length = std::sqrt(x * x + y * y + z * z + w * w);
+    if (length > 0.0) {
+      x /= length;
+      y /= length;
+      z /= length;
+      w /= length;
+    }
+    r[0] = glm::dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0);
+    r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0);
+    r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0);
+  }
+  glm::dmat4 s(1.0);
+  if (!node.scale.empty()) {
+    s[0][0] = node.scale[0];
+    s[1][1] = node.scale[1];
+    s[2][2] = node.scale[2];
+  }
+  return t * r * s;
+}
+
+/// Images are irrelevant to covrast: accept them without decoding.
+bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
+                const unsigned char*, int, void*) {
+  return true;
+}
+
+float clamp_unit(double value) {
+  if (!(value > 0.0)) return 0.0f;  // also NaN
+  return value >= 1.0 ? 1.0f : static_cast<float>(value);
+}
+
+}  // namespace
+
+LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
+                      const std::filesystem::path& base_dir) {
+  const std::string& name = display_name;
+  if (bytes.size() > UINT_MAX) fail(name, "file too large");
+  tinygltf::TinyGLTF loader;
+  loader.SetImageLoader(&skip_image, nullptr);
+  tinygltf::Model model;
+  std::string err;
+  std::string warn;
+  const bool ok =
+      is_glb(bytes)
+          ? loader.LoadBinaryFromMemory(&model, &err, &warn,
+                                        reinterpret_cast<const unsigned char*>(bytes.data()),
+                                        static_cast<unsigned>(bytes.size()), base_dir.string())
+          : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
+                                       static_cast<unsigned>(bytes.size()), base_dir.string());
+  if (!ok) fail(name, err.empty() ? std::string("cannot parse glTF") : one_line(err));
+
+  const Reader reader{model, name};
+  const std::size_t node_count = model.nodes.size();
+
+  // Roots: the chosen scene's nodes, or every node that is nobody's child.
+  std::vector<int> roots;
+  if (!model.scenes.empty()) {
+    const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
+    if (static_cast<std::size_t>(scene_index) >= model.scenes.size()) {
+      fail(name, "scene " + std::to_string(scene_index) + " does not exist");
+    }
+    roots = model.scenes[static_cast<std::size_t>(scene_index)].nodes;
+  } else {
+    std::vector<bool> is_child(node_count, false);
+    for (const tinygltf::Node& node : model.nodes) {
+      for (const int child : node.children) {
+        if (child >= 0 && static_cast<std::size_t>(child) < node_count) {
+          is_child[static_cast<std::size_t>(child)] = true;
+        }
+      }
+    }
+    for (std::size_t i = 0; i < node_count; ++i) {
+      if (!is_child[i]) roots.push_back(static_cast<int>(i));
+    }
+  }
+
+  auto mesh = std::make_shared<MeshData>();
+  mesh->source = display_name;
+  std::vector<glm::vec3> colors;  // per vertex: COLOR_0 x factor, or the factor alone
+  bool any_color_attribute = false;
+  bool any_primitive = false;
+  bool factors_differ = false;
+  glm::vec3 first_factor(1.0f);
+
+  struct Pending {
+    int node;
+    glm::dmat4 parent;
+  };
+  std::vector<Pending> stack;
+  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
+  std::vector<bool> visited(node_count, false);
+  while (!stack.empty()) {
+    const Pending current = stack.back();
+    stack.pop_back();
+    if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
+      fail(name, "node " + std::to_string(current.node) + " does not exist");
+    }
+    const auto node_index = static_cast<std::size_t>(current.node);
+    if (visited[node_index]) {
+      fail(name, "node " + std::to_string(current.node) +
+                     " is reached twice (the node hierarchy must be a tree)");
+    }
+    visited[node_index] = true;
+    const tinygltf::Node& node = model.nodes[node_index];
+    const glm::dmat4 world = current.parent * local_transform(node, name, current.node);
+    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
+      stack.push_back({*it, world});
+    }
+    if (node.mesh < 0) continue;
+    if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) {
+      fail(name, "node " + std::to_string(current.node) + ": mesh " + std::to_string(node.mesh) +
+                     " does not exist");
+    }
+    const tinygltf::Mesh& gltf_mesh = model.meshes[static_cast<std::size_t>(node.mesh)];
+    for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
+      const tinygltf::Primitive& primitive = gltf_mesh.primitives[p];
+      const std::string what =
+          "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p);
+      const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
+      if (mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips, fans: not drawn
+
+      const auto position_it = primitive.attributes.find("POSITION");
+      if (position_it == primitive.attributes.end()) fail(name, what + ": no POSITION attribute");
+      int components = 0;
+      const std::vector<double> positions =
+          reader.read_accessor(what + " POSITION", position_it->second, components);
+      if (components != 3) fail(name, what + ": POSITION must be VEC3");
+      const std::size_t vertex_count = positions.size() / 3;
+      const std::size_t base = mesh->positions.size();
+      if (vertex_count > kMaxVertices - base) fail(name, "too many vertices");
+
+      glm::dvec3 factor(1.0);
+      if (primitive.material >= 0) {
+        if (static_cast<std::size_t>(primitive.material) >= model.materials.size()) {
+          fail(name, what + ": material " + std::to_string(primitive.material) + " does not exist");
+        }
+        const std::vector<double>& f = model.materials[static_cast<std::size_t>(primitive.material)]
+                                           .pbrMetallicRoughness.baseColorFactor;
+        if (f.size() >= 3) factor = glm::dvec3(f[0], f[1], f[2]);
+      }
+      const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
+                                     clamp_unit(factor.b));
+      if (!any_primitive) {
+        first_factor = factor_clamped;
+      } else if (factor_clamped != first_factor) {
+        factors_differ = true;
+      }
+      any_primitive = true;
+
+      for (std::size_t v = 0; v < vertex_count; ++v) {
+        const glm::dvec4 p_world =
+            world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0);
+        mesh->positions.emplace_back(static_cast<float>(p_world.x), static_cast<float>(p_world.y),
+                                     static_cast<float>(p_world.z));
+      }
+
+      const auto color_it = primitive.attributes.find("COLOR_0");
+      if (color_it != primitive.attributes.end()) {
+        any_color_attribute = true;
+        int color_components = 0;
+        const std::vector<double> color_values =
+            reader.read_accessor(what + " COLOR_0", color_it->second, color_components);
+        if (color_components != 3 && color_components != 4) {
+          fail(name, what + ": COLOR_0 must be VEC3 or VEC4");
+        }
+        const auto width = static_cast<std::size_t>(color_components);
+        if (color_values.size() / width != vertex_count) {
+          fail(name, what + ": COLOR_0 and POSITION counts differ");
+        }
+        for (std::size_t v = 0; v < vertex_count; ++v) {
+          colors.emplace_back(clamp_unit(color_values[width * v] * factor.r),
+                              clamp_unit(color_values[width * v + 1] * factor.g),
+                              clamp_unit(color_values[width * v + 2] * factor.b));
+        }
+      } else {
+        colors.insert(colors.end(), vertex_count, factor_clamped);
+      }
+
+      if (primitive.indices >= 0) {
+        int index_components = 0;
+        const std::vector<double> indices =
+            reader.read_accessor(what + " indices", primitive.indices, index_components);
+        const int index_type =
+            model.accessors[static_cast<std::size_t>(primitive.indices)].componentType;
+        if (index_components != 1 || (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                      index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                      index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
+          fail(name, what + ": indices must be unsigned byte, short or int scalars");
+        }
+        if (indices.size() % 3 != 0) {
+          fail(name, what + ": index count " + std::to_string(indices.size()) +
+                         " is not a multiple of 3");
+        }
+        for (const double index : indices) {
+          if (index >= static_cast<double>(vertex_count)) {
+            fail(name, what + ": index " + std::to_string(static_cast<std::uint64_t>(index)) +
+                           " out of range (" + std::to_string(vertex_count) + " vertices)");
+          }
+          mesh->indices.push_back(
+              static_cast<std::uint32_t>(base + static_cast<std::size_t>(index)));
+        }
+      } else {
+        if (vertex_count % 3 != 0) {
+          fail(name,
+               what + ": vertex count " + std::to_string(vertex_count) + " is not a multiple of 3");
+        }
+        for (std::size_t v = 0; v < vertex_count; ++v) {
+          mesh->indices.push_back(static_cast<std::uint32_t>(base + v));
+        }
+      }
+    }
+  }
+
+  LoadedMesh loaded;
+  if (any_color_attribute || factors_differ) {
+    // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
+    mesh->colors_linear = std::move(colors);
+  } else if (any_primitive) {
+    loaded.has_uniform_color = true;
+    loaded.uniform_color_linear = first_factor;
+  }
+  loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
+  loaded.data = std::move(mesh);
+  return loaded;
+}
+
+}  // namespace covrast::detail

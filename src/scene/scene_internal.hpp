@@ -1,0 +1,47 @@
+// Internal interface of the scene loader (src/scene): the mesh parsers work on bytes already
+// read into memory, so that the caller decides how an unopenable file is reported (load_scene
+// names the JSON key, load_mesh names the file).
+#pragma once
+
+#include <covrast/scene.hpp>
+
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <string>
+#include <string_view>
+
+namespace covrast::detail {
+
+/// A parsed mesh file plus what MeshData cannot carry.
+struct LoadedMesh {
+  std::shared_ptr<MeshData> data;
+  /// glTF without COLOR_0 whose primitives all share one baseColorFactor: that factor (linear),
+  /// to be used as the uniform colour when the scene gives none.
+  bool has_uniform_color = false;
+  glm::vec3 uniform_color_linear{1.0f};
+  /// Triangles removed because one of their vertices had a NaN or infinite coordinate.
+  std::size_t dropped_nonfinite_triangles = 0;
+};
+
+/// Reads a whole file. On failure returns false and sets `error` to the system's reason
+/// (e.g. "No such file or directory").
+bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error);
+
+/// Wavefront OBJ: v (optionally with r g b sRGB colours) and f lines; polygons are split into
+/// the fan (0, k, k + 1). `display_name` prefixes every error message ("name:LINE: ...").
+LoadedMesh parse_obj(std::string_view text, const std::string& display_name);
+
+/// glTF 2.0, either JSON (.gltf) or binary (.glb, recognised by its magic). External buffers
+/// are resolved against `base_dir`.
+LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
+                      const std::filesystem::path& base_dir);
+
+/// Removes every triangle that uses a vertex with a non-finite coordinate and sets such
+/// vertices to the origin (nothing references them any more). Returns the number removed.
+std::size_t drop_nonfinite_triangles(MeshData& mesh);
+
+/// True if the bytes start with the binary glTF magic "glTF".
+bool is_glb(std::string_view bytes);
+
+}  // namespace covrast::detail

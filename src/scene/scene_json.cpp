@@ -1,0 +1,322 @@
+// Scene file loader: parses the JSON scene format (docs/scene-format.md), validates every field
+// with a one-line InputError naming the file and the JSON key, converts sRGB display colours to
+// linear light, and loads each mesh file once however many instances name it.
+#include "scene/scene_internal.hpp"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <map>
+#include <string_view>
+#include <utility>
+
+namespace covrast {
+namespace {
+
+using nlohmann::json;
+
+[[noreturn]] void fail(const std::string& file, const std::string& key,
+                       const std::string& message) {
+  throw InputError(file + ": " + key + ": " + message);
+}
+
+/// A JSON value shortened for a one-line message.
+std::string shown(const json& value) {
+  constexpr std::size_t kMaxShown = 40;
+  std::string text = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (text.size() > kMaxShown) text = text.substr(0, kMaxShown) + "...";
+  return text;
+}
+
+/// 1-based line and column of byte `offset` (columns count bytes, like nlohmann's).
+std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size_t offset) {
+  offset = std::min(offset, text.size());
+  std::size_t line = 1;
+  std::size_t line_start = 0;
+  for (std::size_t i = 0; i < offset; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      line_start = i + 1;
+    }
+  }
+  return {line, offset - line_start + 1};
+}
+
+json parse_json(const std::string& text, const std::string& file) {
+  try {
+    // Comments (// and /* */) are accepted as an extension; they change no meaning.
+    return json::parse(text, nullptr, true, true);
+  } catch (const json::parse_error& e) {
+    // e.byte counts the bytes read including the offending one, so it sits at e.byte - 1.
+    const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
+    const auto [line, column] = line_column(text, offset);
+    // nlohmann's text is "[json.exception.parse_error.101] parse error at line L, column C:
+    // <detail>"; keep only the detail, the position is ours.
+    std::string detail = e.what();
+    if (const std::size_t at = detail.find(", column "); at != std::string::npos) {
+      if (const std::size_t colon = detail.find(": ", at); colon != std::string::npos) {
+        detail = detail.substr(colon + 2);
+      }
+    }
+    for (char& c : detail) {
+      if (c == '\n' || c == '\r') c = ' ';
+    }
+    throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
+                     detail);
+  }
+}
+
+class SceneReader {
+ public:
+  explicit SceneReader(std::string file) : file_(std::move(file)) {}
+
+  const json& required(const json& object, const char* key, const std::string& path) const {
+    const auto it = object.find(key);
+    if (it == object.end()) fail(file_, path, "missing");
+    return *it;
+  }
+
+  const json& require_object(const json& value, const std::string& path) const {
+    if (!value.is_object()) fail(file_, path, "expected an object, got " + shown(value));
+    return value;
+  }
+
+  double number(const json& value, const std::string& path) const {
+    if (!value.is_number()) fail(file_, path, "expected a number, got " + shown(value));
+    const double x = value.get<double>();
+    if (!std::isfinite(x)) fail(file_, path, "expected a finite number, got " + shown(value));
+    return x;
+  }
+
+  int image_side(const json& root, const char* key) const {
+    const json& value = required(root, key, key);
+    // Unsigned first: a huge unsigned value must not wrap into range as a signed one.
+    bool in_range = false;
+    if (value.is_number_unsigned()) {
+      const auto side = value.get<unsigned long long>();
+      in_range = side >= 1 && side <= static_cast<unsigned long long>(kMaxImageSide);
+    } else if (value.is_number_integer()) {
+      const auto side = value.get<long long>();
+      in_range = side >= 1 && side <= kMaxImageSide;
+    }
+    if (!in_range) {
+      fail(file_, key,
+           "expected an integer in 1.." + std::to_string(kMaxImageSide) + ", got " + shown(value));
+    }
+    return static_cast<int>(value.get<long long>());
+  }
+
+  glm::dvec3 vec3(const json& value, const std::string& path) const {
+    if (!value.is_array() || value.size() != 3) {
+      fail(file_, path, "expected [x,y,z], got " + shown(value));
+    }
+    return {number(value[0], path + "[0]"), number(value[1], path + "[1]"),
+            number(value[2], path + "[2]")};
+  }
+
+  /// [r,g,b] sRGB display values in 0..1 -> linear light.
+  glm::vec3 srgb_color(const json& value, const std::string& path) const {
+    if (!value.is_array() || value.size() != 3) {
+      fail(file_, path, "expected [r,g,b], got " + shown(value));
+    }
+    glm::vec3 linear(0.0f);
+    for (int c = 0; c < 3; ++c) {
+      const std::string component_path = path + "[" + std::to_string(c) + "]";
+      const double x = number(value[static_cast<std::size_t>(c)], component_path);
+      if (x < 0.0 || x > 1.0) {
+        fail(file_, component_path,
+             "colour component must be in 0..1, got " + shown(value[static_cast<std::size_t>(c)]));
+      }
+      linear[c] = srgb_to_linear(static_cast<float>(x));
+    }
+    return linear;
+  }
+
+  Camera camera(const json& root) const {
+    const json& object = require_object(required(root, "camera", "camera"), "camera");
+    Camera camera;
+    camera.eye = vec3(required(object, "eye", "camera.eye"), "camera.eye");
+    camera.target = vec3(required(object, "target", "camera.target"), "camera.target");
+    camera.up = vec3(required(object, "up", "camera.up"), "camera.up");
+    camera.fovy_deg = number(required(object, "fovy_deg", "camera.fovy_deg"), "camera.fovy_deg");
+    camera.near = number(required(object, "near", "camera.near"), "camera.near");
+    camera.far = number(required(object, "far", "camera.far"), "camera.far");
+    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
+      fail(file_, "camera.fovy_deg",
+           "must be in (0, 180) degrees, got " + shown(object["fovy_deg"]));
+    }
+    if (!(camera.near > 0.0))
+      fail(file_, "camera.near", "must be > 0, got " + shown(object["near"]));
+    if (!(camera.far > camera.near)) {
+      fail(file_, "camera.far", "must be greater than near, got " + shown(object["far"]));
+    }
+    const glm::dvec3 view = camera.target - camera.eye;
+    if (view == glm::dvec3(0.0)) fail(file_, "camera", "eye and target must differ");
+    // Parallel when sin(angle(view, up)) = |view x up| / (|view| |up|) is (nearly) zero.
+    const double up_length = glm::length(camera.up);
+    if (!(up_length > 0.0) ||
+        !(glm::length(glm::cross(view, camera.up)) > 1e-6 * glm::length(view) * up_length)) {
+      fail(file_, "camera.up", "must not be zero or parallel to the view direction");
+    }
+    return camera;
+  }
+
+  /// Row-major: 4 rows of 4 numbers, or 16 numbers in row order; translation in the last
+  /// column. Stored column-major (GLM): model[col][row].
+  glm::dmat4 model_matrix(const json& value, const std::string& path) const {
+    double rows[4][4] = {};
+    if (value.is_array() && value.size() == 16) {
+      for (std::size_t i = 0; i < 16; ++i) {
+        rows[i / 4][i % 4] = number(value[i], path + "[" + std::to_string(i) + "]");
+      }
+    } else if (value.is_array() && value.size() == 4) {
+      for (std::size_t r = 0; r < 4; ++r) {
+        const std::string row_path = path + "[" + std::to_string(r) + "]";
+        if (!value[r].is_array() || value[r].size() != 4) {
+          fail(file_, row_path, "expected a row of 4 numbers, got " + shown(value[r]));
+        }
+        for (std::size_t c = 0; c < 4; ++c) {
+          rows[r][c] = number(value[r][c], row_path + "[" + std::to_string(c) + "]");
+        }
+      }
+    } else {
+      fail(file_, path,
+           "expected 4 rows of 4 numbers or 16 numbers (row-major), got " + shown(value));
+    }
+    if (rows[3][0] != 0.0 || rows[3][1] != 0.0 || rows[3][2] != 0.0 || rows[3][3] != 1.0) {
+      fail(file_, path, "last row must be [0,0,0,1] (affine transform)");
+    }
+    glm::dmat4 model(1.0);
+    for (int r = 0; r < 4; ++r) {
+      for (int c = 0; c < 4; ++c) model[c][r] = rows[r][c];
+    }
+    return model;
+  }
+
+ private:
+  std::string file_;
+};
+
+enum class MeshFormat { Obj, Gltf };
+
+struct CachedMesh {
+  detail::LoadedMesh loaded;
+};
+
+}  // namespace
+
+std::size_t Scene::triangle_count() const {
+  std::size_t total = 0;
+  for (const MeshInstance& instance : meshes) {
+    if (instance.mesh) total += instance.mesh->triangle_count();
+  }
+  return total;
+}
+
+Scene load_scene(const std::filesystem::path& json_path) {
+  const std::string file = json_path.string();
+  std::string text;
+  std::string error;
+  if (!detail::read_whole_file(json_path, text, error)) {
+    throw InputError(file + ": cannot open: " + error);
+  }
+  const json root = parse_json(text, file);
+  if (!root.is_object()) throw InputError(file + ": expected a JSON object at the top level");
+  const SceneReader reader(file);
+
+  Scene scene;
+  scene.source = json_path;
+  scene.width = reader.image_side(root, "width");
+  scene.height = reader.image_side(root, "height");
+  if (const auto it = root.find("background"); it != root.end()) {
+    scene.background_linear = reader.srgb_color(*it, "background");
+  }
+  scene.camera = reader.camera(root);
+
+  const json& meshes = reader.required(root, "meshes", "meshes");
+  if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
+  const std::filesystem::path base_dir = json_path.parent_path();
+  // Instancing: one load per (canonical path, format).
+  std::map<std::pair<std::string, MeshFormat>, CachedMesh> cache;
+
+  for (std::size_t i = 0; i < meshes.size(); ++i) {
+    const std::string key = "meshes[" + std::to_string(i) + "]";
+    const json& entry = reader.require_object(meshes[i], key);
+    const auto obj_it = entry.find("obj");
+    const auto gltf_it = entry.find("gltf");
+    if (obj_it != entry.end() && gltf_it != entry.end()) {
+      fail(file, key, "give either \"obj\" or \"gltf\", not both");
+    }
+    if (obj_it == entry.end() && gltf_it == entry.end()) {
+      fail(file, key, "needs \"obj\" or \"gltf\" (a mesh file path)");
+    }
+    const MeshFormat format = obj_it != entry.end() ? MeshFormat::Obj : MeshFormat::Gltf;
+    const json& path_value = format == MeshFormat::Obj ? *obj_it : *gltf_it;
+    const std::string path_key = key + (format == MeshFormat::Obj ? ".obj" : ".gltf");
+    if (!path_value.is_string() || path_value.get<std::string>().empty()) {
+      fail(file, path_key, "expected a file path string, got " + shown(path_value));
+    }
+    const std::string relative = path_value.get<std::string>();
+    const std::filesystem::path full = base_dir / std::filesystem::path(relative);
+
+    std::error_code ec;
+    const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
+    if (ec) fail(file, key, "cannot open '" + relative + "': " + ec.message());
+    auto cached = cache.find({canonical.string(), format});
+    const bool first_use = cached == cache.end();
+    if (first_use) {
+      std::string bytes;
+      if (!detail::read_whole_file(full, bytes, error)) {
+        fail(file, key, "cannot open '" + relative + "': " + error);
+      }
+      const std::string display = full.lexically_normal().string();
+      CachedMesh entry_data;
+      entry_data.loaded = format == MeshFormat::Obj
+                              ? detail::parse_obj(bytes, display)
+                              : detail::parse_gltf(bytes, display, full.parent_path());
+      if (entry_data.loaded.dropped_nonfinite_triangles > 0) {
+        scene.warnings.push_back(display + ": dropped " +
+                                 std::to_string(entry_data.loaded.dropped_nonfinite_triangles) +
+                                 " triangles with NaN/Inf coordinates");
+      }
+      cached =
+          cache.emplace(std::make_pair(canonical.string(), format), std::move(entry_data)).first;
+    }
+    const detail::LoadedMesh& loaded = cached->second.loaded;
+    // Counted per instance: each instance would have drawn the dropped triangles.
+    scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
+
+    MeshInstance instance;
+    instance.mesh = loaded.data;
+    const bool has_vertex_colors = !loaded.data->colors_linear.empty();
+    if (const auto color_it = entry.find("color"); color_it != entry.end()) {
+      const json& color = *color_it;
+      const std::string color_key = key + ".color";
+      if (color.is_array()) {
+        instance.color_source = ColorSource::Uniform;
+        instance.color_linear = reader.srgb_color(color, color_key);
+      } else if (color.is_string() && color.get<std::string>() == "per_triangle") {
+        instance.color_source = ColorSource::PerTriangle;
+      } else if (color.is_string() && color.get<std::string>() == "vertex") {
+        if (!has_vertex_colors) {
+          fail(file, color_key, "\"vertex\" but '" + relative + "' has no vertex colours");
+        }
+        instance.color_source = ColorSource::Vertex;
+      } else {
+        fail(file, color_key,
+             "expected [r,g,b], \"per_triangle\" or \"vertex\", got " + shown(color));
+      }
+    } else if (has_vertex_colors) {
+      instance.color_source = ColorSource::Vertex;
+    } else if (loaded.has_uniform_color) {
+      instance.color_linear = loaded.uniform_color_linear;
+    }
+    if (const auto model_it = entry.find("model"); model_it != entry.end()) {
+      instance.model = reader.model_matrix(*model_it, key + ".model");
+    }
+    scene.meshes.push_back(std::move(instance));
+  }
+  return scene;
+}
+
+}  // namespace covrast

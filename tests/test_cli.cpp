@@ -1,0 +1,417 @@
+// Tests of the covrast command line (the built executable, COVRAST_CLI_PATH): exit codes,
+// one-line error messages, and that failed runs create no output and leave existing files
+// untouched. Each test writes its scenes, meshes and images into a fresh temporary directory.
+#include <covrast/image.hpp>
+
+#include <sys/wait.h>
+#include <unistd.h>
+#include <catch2/catch.hpp>
+
+#include <nlohmann/json.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <initializer_list>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+class TempDir {
+ public:
+  TempDir() {
+    static std::atomic<int> counter{0};
+    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
+    path_ = fs::temp_directory_path() / ("covrast-test-cli-" + std::to_string(::getpid()) + "-" +
+                                         std::to_string(ticks) + "-" + std::to_string(counter++));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path_, ec);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+  fs::path operator/(const std::string& name) const { return path_ / name; }
+
+ private:
+  fs::path path_;
+};
+
+void write_text(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+  REQUIRE(out.good());
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+/// Single-quotes an argument for /bin/sh.
+std::string quoted(const std::string& arg) {
+  std::string out = "'";
+  for (char c : arg) {
+    if (c == '\'') {
+      out += "'\\''";
+    } else {
+      out += c;
+    }
+  }
+  return out + "'";
+}
+
+struct RunResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+/// Runs the CLI with `args`, capturing stdout and stderr in files inside `dir`.
+RunResult run_cli(const TempDir& dir, std::initializer_list<std::string> args) {
+  const fs::path out_file = dir / "stdout.txt";
+  const fs::path err_file = dir / "stderr.txt";
+  std::string command = quoted(COVRAST_CLI_PATH);
+  // Appending piecewise (not `" " + quoted(...)`) also avoids a g++ 12 -Wrestrict false positive.
+  for (const std::string& arg : args) {
+    command += ' ';
+    command += quoted(arg);
+  }
+  command += " >";
+  command += quoted(out_file.string());
+  command += " 2>";
+  command += quoted(err_file.string());
+  command += " </dev/null";
+  const int status = std::system(command.c_str());
+  RunResult result;
+  REQUIRE(status != -1);
+  REQUIRE(WIFEXITED(status));
+  result.exit_code = WEXITSTATUS(status);
+  result.out = read_text(out_file);
+  result.err = read_text(err_file);
+  fs::remove(out_file);
+  fs::remove(err_file);
+  return result;
+}
+
+/// An error must be exactly one line on stderr starting with "covrast: error: ".
+void check_one_error_line(const RunResult& r) {
+  INFO("stderr: " << r.err);
+  REQUIRE(r.err.rfind("covrast: error: ", 0) == 0);
+  REQUIRE(r.err.find('\n') == r.err.size() - 1);
+}
+
+/// Files in `dir` other than the captured stdout/stderr and the inputs listed.
+std::vector<std::string> extra_files(const TempDir& dir,
+                                     std::initializer_list<std::string> inputs) {
+  std::vector<std::string> names;
+  for (const auto& entry : fs::directory_iterator(dir.path())) {
+    const std::string name = entry.path().filename().string();
+    bool is_input = false;
+    for (const std::string& input : inputs) is_input = is_input || name == input;
+    if (!is_input) names.push_back(name);
+  }
+  return names;
+}
+
+const char* const kTriangleObj =
+    "v 0 1 0\n"
+    "v -0.866025404 -0.5 0\n"
+    "v 0.866025404 -0.5 0\n"
+    "f 1 2 3\n";
+
+std::string scene_json(const std::string& obj, int width = 24, int height = 16) {
+  return "{\n  \"width\": " + std::to_string(width) + ",\n  \"height\": " + std::to_string(height) +
+         ",\n  \"background\": [0, 0, 0],\n"
+         "  \"camera\": {\"eye\": [0, 0, 3], \"target\": [0, 0, 0], \"up\": [0, 1, 0], "
+         "\"fovy_deg\": 45, \"near\": 0.5, \"far\": 10},\n"
+         "  \"meshes\": [{\"obj\": \"" +
+         obj + "\", \"color\": [1, 0.5, 0.25]}]\n}\n";
+}
+
+/// A directory with a good scene "scene.json" referencing "tri.obj".
+void write_good_scene(const TempDir& dir) {
+  write_text(dir / "tri.obj", kTriangleObj);
+  write_text(dir / "scene.json", scene_json("tri.obj"));
+}
+
+/// Renders with `extra` arguments that must fail with exit 2, one error line, and no output.
+RunResult expect_render_fails(const TempDir& dir, std::initializer_list<std::string> args) {
+  const RunResult r = run_cli(dir, args);
+  INFO("stdout: " << r.out);
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+  CHECK(r.out.empty());
+  return r;
+}
+
+covrast::Image test_image(int width, int height, int seed) {
+  covrast::Image image;
+  image.width = width;
+  image.height = height;
+  image.rgb.resize(std::size_t(width) * height * 3);
+  for (std::size_t i = 0; i < image.rgb.size(); ++i) {
+    image.rgb[i] = std::uint8_t((i * 37 + std::size_t(seed) * 11) % 256);
+  }
+  return image;
+}
+
+}  // namespace
+
+TEST_CASE("cli: --help and --version exit 0", "[cli]") {
+  TempDir dir;
+  RunResult r = run_cli(dir, {"--help"});
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.find("render") != std::string::npos);
+  CHECK(r.out.find("info") != std::string::npos);
+  CHECK(r.out.find("compare") != std::string::npos);
+  for (const char* sub : {"render", "info", "compare"}) {
+    r = run_cli(dir, {sub, "--help"});
+    INFO(sub);
+    CHECK(r.exit_code == 0);
+    CHECK(r.out.find("Usage") != std::string::npos);
+  }
+  r = run_cli(dir, {"render", "--help"});
+  CHECK(r.out.find("--tile") != std::string::npos);
+  CHECK(r.out.find("--stats") != std::string::npos);
+  r = run_cli(dir, {"--version"});
+  CHECK(r.exit_code == 0);
+  CHECK(r.out.rfind("covrast ", 0) == 0);
+}
+
+TEST_CASE("cli: usage errors exit 2 with one error line", "[cli]") {
+  TempDir dir;
+  check_one_error_line(run_cli(dir, {}));
+  CHECK(run_cli(dir, {}).exit_code == 2);
+  RunResult r = run_cli(dir, {"frobnicate"});
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+  r = run_cli(dir, {"render", "x.json"});  // missing -o
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+}
+
+TEST_CASE("cli: render rejects bad input with exit 2 and creates nothing", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  const std::string scene = (dir / "scene.json").string();
+  const std::string out = (dir / "out.png").string();
+
+  SECTION("malformed JSON names file:line:col") {
+    write_text(dir / "bad.json", "{\n  \"width\": 24,\n  \"height\" 16\n}\n");
+    const RunResult r =
+        expect_render_fails(dir, {"render", (dir / "bad.json").string(), "-o", out});
+    CHECK(r.err.find((dir / "bad.json").string() + ":3:") != std::string::npos);
+    CHECK(extra_files(dir, {"scene.json", "tri.obj", "bad.json"}).empty());
+  }
+  SECTION("missing mesh file") {
+    write_text(dir / "missing.json", scene_json("nope.obj"));
+    const RunResult r =
+        expect_render_fails(dir, {"render", (dir / "missing.json").string(), "-o", out});
+    CHECK(r.err.find("nope.obj") != std::string::npos);
+    CHECK(extra_files(dir, {"scene.json", "tri.obj", "missing.json"}).empty());
+  }
+  SECTION("out-of-range face index") {
+    write_text(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+    write_text(dir / "badface.json", scene_json("bad.obj"));
+    const RunResult r =
+        expect_render_fails(dir, {"render", (dir / "badface.json").string(), "-o", out});
+    CHECK(r.err.find("bad.obj") != std::string::npos);
+    CHECK(extra_files(dir, {"scene.json", "tri.obj", "bad.obj", "badface.json"}).empty());
+  }
+  SECTION("size 0x10") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--size", "0x10"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("size 20000x10") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--size", "20000x10"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("malformed size") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--size", "24by16"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("unwritable output path") {
+    const RunResult r = expect_render_fails(dir, {"render", scene, "-o", "/nonexistent-dir/x.png"});
+    CHECK(r.err.find("/nonexistent-dir/x.png") != std::string::npos);
+    CHECK_FALSE(fs::exists("/nonexistent-dir"));
+  }
+  SECTION("unknown mode") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--mode", "blurry"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("tile 7") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--tile", "7"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("repeat 0") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--repeat", "0"});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+  SECTION("unsupported depth extension") {
+    expect_render_fails(dir, {"render", scene, "-o", out, "--depth", (dir / "d.exr").string()});
+    CHECK(extra_files(dir, {"scene.json", "tri.obj"}).empty());
+  }
+}
+
+TEST_CASE("cli: a failed render leaves an existing output file untouched", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  const fs::path out = dir / "out.png";
+  const std::string before = "not really a png, but it must survive byte for byte\n";
+  write_text(out, before);
+  write_text(dir / "bad.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n");
+  write_text(dir / "badface.json", scene_json("bad.obj"));
+
+  expect_render_fails(dir, {"render", (dir / "badface.json").string(), "-o", out.string()});
+  CHECK(read_text(out) == before);
+  expect_render_fails(
+      dir, {"render", (dir / "scene.json").string(), "-o", out.string(), "--size", "0x10"});
+  CHECK(read_text(out) == before);
+  expect_render_fails(dir,
+                      {"render", (dir / "scene.json").string(), "-o", out.string(), "--tile", "7"});
+  CHECK(read_text(out) == before);
+  CHECK(extra_files(dir, {"scene.json", "tri.obj", "out.png", "bad.obj", "badface.json"}).empty());
+}
+
+TEST_CASE("cli: render of a good scene writes a PNG of the requested size", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  const fs::path out = dir / "out.png";
+
+  RunResult r = run_cli(dir, {"render", (dir / "scene.json").string(), "-o", out.string()});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out == "wrote " + out.string() + "\n");
+  CHECK(r.err.empty());
+  covrast::Image image = covrast::read_png(out);
+  CHECK(image.width == 24);
+  CHECK(image.height == 16);
+  CHECK(extra_files(dir, {"scene.json", "tri.obj", "out.png"}).empty());
+
+  // --size overrides the scene; --quiet --stats prints only the JSON line.
+  r = run_cli(dir, {"render", (dir / "scene.json").string(), "-o", out.string(), "--size", "40x8",
+                    "--quiet", "--stats", "--repeat", "3", "--tile", "16", "--threads", "2"});
+  REQUIRE(r.exit_code == 0);
+  image = covrast::read_png(out);
+  CHECK(image.width == 40);
+  CHECK(image.height == 8);
+  REQUIRE(r.out.find('\n') == r.out.size() - 1);
+  const nlohmann::json stats = nlohmann::json::parse(r.out);
+  CHECK(stats.at("mode") == "coverage");
+  CHECK(stats.at("width") == 40);
+  CHECK(stats.at("height") == 8);
+  CHECK(stats.at("tile") == 16);
+  CHECK(stats.at("threads") == 2);
+  CHECK(stats.at("frames") == 3);
+  CHECK(stats.at("triangles").at("in") == 1);
+  for (const char* key : {"setup_ms", "binning_ms", "raster_ms", "resolve_ms", "render_ms"}) {
+    INFO(key);
+    CHECK(stats.at(key).get<double>() >= 0.0);
+  }
+
+  // Depth as PFM: header of a 40x8 greyscale float map.
+  const fs::path depth = dir / "depth.pfm";
+  r = run_cli(dir, {"render", (dir / "scene.json").string(), "-o", out.string(), "--size", "40x8",
+                    "--depth", depth.string()});
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out == "wrote " + out.string() + "\nwrote " + depth.string() + "\n");
+  const std::string pfm = read_text(depth);
+  const std::string header = "Pf\n40 8\n-1.0\n";
+  CHECK(pfm.size() == header.size() + 40 * 8 * 4);
+  CHECK(pfm.compare(0, header.size(), header) == 0);
+}
+
+TEST_CASE("cli: info describes a good scene", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  RunResult r = run_cli(dir, {"info", (dir / "scene.json").string()});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("24x16") != std::string::npos);
+  CHECK(r.out.find("tri.obj") != std::string::npos);
+
+  r = run_cli(dir, {"info", (dir / "scene.json").string(), "--json"});
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json info = nlohmann::json::parse(r.out);
+  CHECK(info.at("width") == 24);
+  CHECK(info.at("height") == 16);
+  CHECK(info.at("triangles") == 1);
+  CHECK(info.at("vertices") == 3);
+  REQUIRE(info.at("meshes").size() == 1);
+  CHECK(info.at("meshes")[0].at("triangles") == 1);
+  CHECK(info.at("meshes")[0].at("color_source") == "uniform");
+  CHECK(info.at("camera").at("fovy_deg") == 45.0);
+  // The triangle's world bounds (identity model): x in +-0.866025404, y in [-0.5, 1], z = 0.
+  const nlohmann::json& bounds = info.at("bounds");
+  CHECK(bounds.at("min")[0].get<double>() == Approx(-0.866025404));
+  CHECK(bounds.at("min")[1].get<double>() == Approx(-0.5));
+  CHECK(bounds.at("max")[0].get<double>() == Approx(0.866025404));
+  CHECK(bounds.at("max")[1].get<double>() == Approx(1.0));
+  CHECK(bounds.at("max")[2].get<double>() == 0.0);
+  CHECK(info.at("warnings").empty());
+
+  r = run_cli(dir, {"info", (dir / "nope.json").string()});
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+}
+
+TEST_CASE("cli: compare exit codes follow the thresholds", "[cli]") {
+  TempDir dir;
+  const covrast::Image a = test_image(9, 7, 1);
+  covrast::Image b = a;
+  b.pixel(4, 3)[1] = std::uint8_t(b.pixel(4, 3)[1] ^ 0x40);  // one channel off by 64
+  covrast::write_png(a, dir / "a.png");
+  covrast::write_png(a, dir / "a2.png");
+  covrast::write_png(b, dir / "b.png");
+  const std::string pa = (dir / "a.png").string();
+  const std::string pa2 = (dir / "a2.png").string();
+  const std::string pb = (dir / "b.png").string();
+
+  RunResult r =
+      run_cli(dir, {"compare", pa, pa2, "--max-rmse", "0", "--max-diff", "0", "--max-pixels", "0"});
+  CHECK(r.exit_code == 0);
+  CHECK(r.err.empty());
+
+  r = run_cli(dir, {"compare", pa, pb, "--max-diff", "8"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.err == "FAIL: max_diff 64 > 8\n");
+
+  r = run_cli(dir, {"compare", pa, pb, "--max-pixels", "0.5", "--max-diff", "64"});
+  CHECK(r.exit_code == 0);  // 1 of 63 pixels differs; largest difference exactly 64
+
+  r = run_cli(dir, {"compare", pa, pb, "--max-pixels", "0.01"});
+  CHECK(r.exit_code == 1);
+  CHECK(r.err.rfind("FAIL: share_over_1 ", 0) == 0);
+
+  // No thresholds: a difference alone is not a failure.
+  r = run_cli(dir, {"compare", pa, pb, "--json", "--heatmap", (dir / "heat.png").string()});
+  CHECK(r.exit_code == 0);
+  REQUIRE(r.out.find('\n') == r.out.size() - 1);
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  CHECK(j.at("max_diff_srgb8") == 64);
+  CHECK(j.at("pixels_over_1") == 1);
+  const covrast::Image heat = covrast::read_png(dir / "heat.png");
+  CHECK(heat.width == 9);
+  CHECK(heat.height == 7);
+
+  // Size mismatch and unreadable input are bad input.
+  covrast::write_png(test_image(8, 7, 1), dir / "small.png");
+  r = run_cli(dir, {"compare", pa, (dir / "small.png").string()});
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+  r = run_cli(dir, {"compare", pa, (dir / "missing.png").string()});
+  CHECK(r.exit_code == 2);
+  check_one_error_line(r);
+  CHECK(r.err.find("missing.png") != std::string::npos);
+}
