@@ -538,12 +538,15 @@ TEST_CASE("glTF with a data: URI buffer, node hierarchy and COLOR_0", "[scene]")
       {"asset", {{"version", "2.0"}}},
       {"scene", 0},
       {"scenes", {{{"nodes", {0}}}}},
-      // Node 0: translation (1,2,3) and scale (2,3,4) (T * S); its child node 1 rotates by
-      // +90 degrees about z and holds the mesh. Node 2 also holds the mesh but is in no scene,
-      // so it must be ignored.
+      // Node 0: translation (1,2,3), rotation +90 degrees about z, scale (2,3,4), so its matrix
+      // is T * R * S; its child node 1 translates by (0,0,1) and holds the mesh. Node 2 also
+      // holds the mesh but is in no scene, so it must be ignored.
       {"nodes",
-       {{{"translation", {1, 2, 3}}, {"scale", {2, 3, 4}}, {"children", {1}}},
-        {{"rotation", {0, 0, std::sqrt(0.5), std::sqrt(0.5)}}, {"mesh", 0}},
+       {{{"translation", {1, 2, 3}},
+         {"rotation", {0, 0, std::sqrt(0.5), std::sqrt(0.5)}},
+         {"scale", {2, 3, 4}},
+         {"children", {1}}},
+        {{"translation", {0, 0, 1}}, {"mesh", 0}},
         {{"mesh", 0}}}},
       {"meshes",
        {{{"primitives",
@@ -572,9 +575,11 @@ TEST_CASE("glTF with a data: URI buffer, node hierarchy and COLOR_0", "[scene]")
   };
   const fs::path file = dir.write_json("model.gltf", gltf);
   const auto mesh = covrast::load_mesh(file);
-  // p_world = T S R p: (0,0,0) -> (1,2,3); (1,0,0) -> R (0,1,0) -> S (0,3,0) -> (1,5,3);
-  // (0,1,0) -> R (-1,0,0) -> S (-2,0,0) -> (-1,2,3).
-  const glm::vec3 expected_positions[] = {{1, 2, 3}, {1, 5, 3}, {-1, 2, 3}};
+  // p_world = T R S (p + (0,0,1)):
+  //   (0,0,0) -> (0,0,1) -> S (0,0,4) -> R (0,0,4)  -> (1,2,7)
+  //   (1,0,0) -> (1,0,1) -> S (2,0,4) -> R (0,2,4)  -> (1,4,7)
+  //   (0,1,0) -> (0,1,1) -> S (0,3,4) -> R (-3,0,4) -> (-2,2,7)
+  const glm::vec3 expected_positions[] = {{1, 2, 7}, {1, 4, 7}, {-2, 2, 7}};
   REQUIRE(mesh->positions.size() == 3);
   for (int v = 0; v < 3; ++v) {
     for (int c = 0; c < 3; ++c) {

@@ -19,8 +19,8 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& args) {
       "difference (8-bit sRGB) and the shares of pixels off by more than 1/255 and 8/255. "
       "With thresholds, prints 'FAIL: <measure> <value> > <limit>' to stderr for each one "
       "exceeded and exits 1; exits 0 when all hold.");
-  sub->add_option("a", args.image_a, "First image (PNG)")->required()->type_name("A.png");
-  sub->add_option("b", args.image_b, "Second image (PNG)")->required()->type_name("B.png");
+  sub->add_option("A", args.image_a, "First image (PNG)")->required()->type_name("PNG");
+  sub->add_option("B", args.image_b, "Second image (PNG)")->required()->type_name("PNG");
   sub->add_option("--heatmap", args.heatmap,
                   "Write a heat map of the per-pixel difference (black = equal .. red >= 32/255)")
       ->type_name("OUT.png");

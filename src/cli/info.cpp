@@ -59,7 +59,9 @@ const char* color_source_name(ColorSource source) {
   return "unknown";
 }
 
-nlohmann::json vec_json(const glm::dvec3& v) { return nlohmann::json::array({v.x, v.y, v.z}); }
+nlohmann::ordered_json vec_json(const glm::dvec3& v) {
+  return nlohmann::ordered_json::array({v.x, v.y, v.z});
+}
 
 std::string vec_text(const glm::dvec3& v) {
   return "(" + format_number(v.x) + ", " + format_number(v.y) + ", " + format_number(v.z) + ")";
@@ -77,9 +79,9 @@ std::string mesh_source(const MeshInstance& instance) {
   return instance.mesh ? instance.mesh->source : std::string();
 }
 
-nlohmann::json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
-                         std::size_t total_vertices) {
-  nlohmann::json j;
+nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
+                                 std::size_t total_vertices) {
+  nlohmann::ordered_json j;
   j["file"] = args.scene;
   j["width"] = scene.width;
   j["height"] = scene.height;
@@ -87,12 +89,12 @@ nlohmann::json info_json(const InfoArgs& args, const Scene& scene, const Bounds&
   j["camera"] = {{"eye", vec_json(scene.camera.eye)}, {"target", vec_json(scene.camera.target)},
                  {"up", vec_json(scene.camera.up)},   {"fovy_deg", scene.camera.fovy_deg},
                  {"near", scene.camera.near},         {"far", scene.camera.far}};
-  nlohmann::json meshes = nlohmann::json::array();
+  nlohmann::ordered_json meshes = nlohmann::ordered_json::array();
   for (const MeshInstance& instance : scene.meshes) {
-    nlohmann::json m = {{"source", mesh_source(instance)},
-                        {"triangles", triangle_count(instance)},
-                        {"vertices", vertex_count(instance)},
-                        {"color_source", color_source_name(instance.color_source)}};
+    nlohmann::ordered_json m = {{"source", mesh_source(instance)},
+                                {"triangles", triangle_count(instance)},
+                                {"vertices", vertex_count(instance)},
+                                {"color_source", color_source_name(instance.color_source)}};
     if (instance.color_source == ColorSource::Uniform) {
       m["color_linear"] = vec_json(glm::dvec3(instance.color_linear));
     }

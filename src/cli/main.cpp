@@ -55,6 +55,14 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // CLI11 reports an unknown command word only as "A subcommand is required".
+    const std::string first = argc > 1 ? argv[1] : "";
+    if (!first.empty() && first[0] != '-' && first != "render" && first != "info" &&
+        first != "compare") {
+      print_error("unknown command '" + first +
+                  "' (expected render, info or compare; run 'covrast --help' for usage)");
+      return 2;
+    }
     print_error(std::string(e.what()) + " (run 'covrast --help' for usage)");
     return 2;
   }

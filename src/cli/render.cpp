@@ -55,8 +55,8 @@ double median(std::vector<double> values) {
   return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
 }
 
-nlohmann::json stats_json(const RenderOptions& options, const RenderResult& last,
-                          const std::vector<RenderStats>& frames) {
+nlohmann::ordered_json stats_json(const RenderOptions& options, const RenderResult& last,
+                                  const std::vector<RenderStats>& frames) {
   const auto median_of = [&](double RenderStats::*field) {
     std::vector<double> values;
     values.reserve(frames.size());
@@ -64,7 +64,7 @@ nlohmann::json stats_json(const RenderOptions& options, const RenderResult& last
     return median(std::move(values));
   };
   const RenderStats& s = last.stats;
-  nlohmann::json j;
+  nlohmann::ordered_json j;
   j["mode"] = to_string(options.mode);
   j["width"] = last.color.width;
   j["height"] = last.color.height;
@@ -98,8 +98,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->type_name("SCENE.json");
   sub->add_option("-o,--output", args.output, "Output PNG file")->required()->type_name("OUT.png");
   sub->add_option("--mode", args.mode,
-                  "Anti-aliasing mode: aliased, coverage (exact analytic area, default), "
-                  "coverage-blend, ssaa:N, ssaa-grid:N, msaa:K, reference")
+                  "Anti-aliasing mode: coverage (exact analytic area, the default), "
+                  "coverage-blend, aliased, ssaa:N and ssaa-grid:N (N x N samples, N = 1..16), "
+                  "msaa:K (K = 2, 4, 8, 16), reference (double-precision ground truth)")
       ->capture_default_str()
       ->type_name("MODE");
   sub->add_option(
@@ -118,7 +119,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
                 std::from_chars(text.data(), text.data() + text.size(), value);
             if (error != std::errc() || end != text.data() + text.size() || value < kMinTile ||
                 value > kMaxTile || value % 8 != 0) {
-              return "tile must be an integer in 8..256 and a multiple of 8, got '" + text + "'";
+              return "must be an integer in 8..256 and a multiple of 8, got '" + text + "'";
             }
             return {};
           },

@@ -19,10 +19,21 @@ namespace covrast::detail {
 /// balance 500k triangles over a few cores.
 inline constexpr std::uint32_t kTrianglesPerChunk = 8192;
 
-/// Clip-space vertices of one mesh instance.
+/// A vertex after the viewport transform, snapped to 24.8 fixed point.
+struct SnappedVertex {
+  std::int32_t x_fx8;
+  std::int32_t y_fx8;
+  double z_window;  ///< [0, 1]
+  float inv_w;      ///< 1 / clip w
+};
+
+/// Clip-space vertices of one mesh instance, with their clip outcodes and, for vertices
+/// inside every plane, their snapped screen position (shared by all their triangles).
 struct InstanceVertices {
   std::vector<glm::dvec4> clip;
-  std::vector<glm::vec3> color_linear;  ///< only for ColorSource::Vertex
+  std::vector<std::uint8_t> outcode;     ///< bit p set: outside clip plane p
+  std::vector<SnappedVertex> snapped;    ///< valid where outcode == 0
+  std::vector<glm::vec3> color_linear;   ///< only for ColorSource::Vertex
 };
 
 struct SetupCounters {
@@ -49,6 +60,11 @@ public:
                    SetupCounters& counters) const;
 
 private:
+  SnappedVertex snap(const glm::dvec4& clip) const;
+  unsigned outcode(const glm::dvec4& clip) const;
+  void emit_triangle(const SnappedVertex* v, const glm::vec3* color, bool flat,
+                     std::uint32_t primitive, std::uint32_t surface,
+                     std::vector<TriangleSetup>& out, SetupCounters& counters) const;
   void setup_triangle(std::size_t instance, std::uint32_t local_index, std::uint32_t primitive,
                       std::vector<TriangleSetup>& out, SetupCounters& counters) const;
 
@@ -58,6 +74,7 @@ private:
   glm::dmat4 view_projection_;
   double guard_x_;  ///< guard band half-extent in NDC units, x
   double guard_y_;  ///< same, y
+  glm::dvec4 planes_[6];  ///< homogeneous clip planes: inside where dot(plane, v) >= 0
   std::vector<std::uint64_t> first_triangle_;  ///< prefix sums of triangle counts
   std::vector<InstanceVertices> vertices_;
 };

@@ -156,6 +156,8 @@ RenderResult Renderer::render_frame() {
   detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
                              im.scene.background_linear};
   for (auto& c : im.setup_counters) c = {};
+  std::uint64_t overflows_before = 0;
+  for (const auto& r : im.rasterizers) overflows_before += r->overflow_count();
   for (auto& r : im.resolve_thread_ms) r = 0;
 
   Clock::time_point t0, t1, t2, t3;
@@ -214,6 +216,7 @@ RenderResult Renderer::render_frame() {
     st.scratch_bytes += r->scratch_bytes();
     st.fragment_overflows += r->overflow_count();
   }
+  st.fragment_overflows -= overflows_before;  // the counters run over the Renderer's life
   st.setup_ms = ms_between(t0, t1);
   st.binning_ms = ms_between(t1, t2);
   // The tile pass interleaves raster and resolve per tile; the resolve share is the summed

@@ -15,7 +15,8 @@ namespace hn = hwy::HWY_NAMESPACE;
 
 void CoverageRows(const CoverageColumns& columns, int col, int row_begin, int row_end, int sign,
                   std::uint16_t* out, std::size_t stride) {
-  const hn::ScalableTag<float> df;
+  // At most one group of columns per vector: wider targets use a narrower vector.
+  const hn::CappedTag<float, kColumnGroup> df;
   const hn::RebindToSigned<decltype(df)> di;
   const hn::Rebind<std::uint16_t, decltype(df)> du16;
   const std::size_t lanes = hn::Lanes(df);

@@ -36,7 +36,7 @@ inline std::uint8_t coverage_to_alpha8(std::uint32_t coverage) {
 
 /// Columns the kernel processes per call; every SIMD target splits them into its own
 /// vectors, so the result does not depend on the vector width.
-inline constexpr int kColumnGroup = 16;
+inline constexpr int kColumnGroup = 8;
 /// Most columns one triangle can span inside a tile, plus a partial group.
 inline constexpr int kMaxSpanColumns = 256 + kColumnGroup;
 

@@ -12,23 +12,48 @@
 namespace covrast::detail {
 namespace {
 
-/// Sign of (front - behind) depth at the four corners of pixel (x, y): both planes are
-/// affine, so their difference is extreme at the corners.
+/// Window depth of a triangle's plane at the four corners of pixel (x, y), always from the
+/// same operations so that every comparison below sees the same numbers.
+struct CornerDepths {
+  double z[4];
+  double min() const { return std::min(std::min(z[0], z[1]), std::min(z[2], z[3])); }
+  double max() const { return std::max(std::max(z[0], z[1]), std::max(z[2], z[3])); }
+};
+
+CornerDepths corner_depths(const TriangleSetup& t, int x, int y) {
+  const double z = t.depth_at(x, y);
+  return {{z, z + t.dzdx, z + t.dzdy, (z + t.dzdx) + t.dzdy}};
+}
+
+struct DepthRange {
+  double min;
+  double max;
+};
+constexpr double kFar = std::numeric_limits<double>::infinity();
+
+DepthRange depth_range(const TriangleSetup& t, int x, int y) {
+  CornerDepths c = corner_depths(t, x, y);
+  return {c.min(), c.max()};
+}
+
+/// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
+/// difference is extreme at the corners: nearer at all four corners is in front; farther or
+/// equal at all four is behind (equal depth keeps the earlier triangle); else they cross.
 enum class DepthOrder { InFront, Behind, Crossing };
 
-DepthOrder compare_planes(const TriangleSetup& front, const TriangleSetup& behind, int x, int y) {
-  int nearer = 0, farther_or_equal = 0;
-  for (int k = 0; k < 4; ++k) {
-    double cx = x + (k & 1), cy = y + (k >> 1);
-    if (front.depth_at(cx, cy) < behind.depth_at(cx, cy)) {
-      ++nearer;
-    } else {
-      ++farther_or_equal;
-    }
-  }
+DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y) {
+  CornerDepths a = corner_depths(t, x, y), b = corner_depths(other, x, y);
+  if (a.max() < b.min()) return DepthOrder::InFront;
+  if (a.min() >= b.max()) return DepthOrder::Behind;
+  int nearer = 0;
+  for (int k = 0; k < 4; ++k) nearer += a.z[k] < b.z[k];
   if (nearer == 4) return DepthOrder::InFront;
-  if (farther_or_equal == 4) return DepthOrder::Behind;
+  if (nearer == 0) return DepthOrder::Behind;
   return DepthOrder::Crossing;
+}
+
+bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
+  return a.surface == b.surface && a.front_facing == b.front_facing;
 }
 
 /// Samples of an 8x8 grid at ((i + 0.5) / 8, (j + 0.5) / 8) inside pixel (x, y), bit
@@ -87,7 +112,7 @@ void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t covera
       opaque_[pixel] = t;
       return;
     }
-    switch (compare_planes(*t, *opaque, x, y)) {
+    switch (order_of(*t, *opaque, x, y)) {
       case DepthOrder::InFront:
         opaque_[pixel] = t;
         return;
@@ -96,7 +121,7 @@ void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t covera
       case DepthOrder::Crossing:
         break;
     }
-  } else if (opaque != nullptr && compare_planes(*t, *opaque, x, y) == DepthOrder::Behind) {
+  } else if (opaque != nullptr && order_of(*t, *opaque, x, y) == DepthOrder::Behind) {
     return;  // hidden everywhere in the pixel
   }
   add_fragment(pixel, x, y, t, coverage);
@@ -112,7 +137,7 @@ void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSe
     int n = 0;
     for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
       if (opaque != nullptr &&
-          compare_planes(*pool_[f].triangle, *opaque, x, y) == DepthOrder::Behind) {
+          order_of(*pool_[f].triangle, *opaque, x, y) == DepthOrder::Behind) {
         continue;
       }
       if (last == kEnd) {
@@ -171,30 +196,61 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
                             : std::numeric_limits<float>::infinity();
   if (head_[pixel] == kEnd) return behind;
 
+  const DepthRange opaque_range =
+      opaque != nullptr ? depth_range(*opaque, x, y) : DepthRange{kFar, kFar};
   const TriangleSetup* tri[kMaxFragmentsPerPixel];
   std::uint32_t cov[kMaxFragmentsPerPixel];
-  int n = 0;
-  bool one_surface = true, all_in_front = true;
+  DepthRange range[kMaxFragmentsPerPixel];
+  int group[kMaxFragmentsPerPixel];
+  // Fragments of one surface (mesh instance and facing) form a group: in one pixel they
+  // are adjacent pieces of a tessellation, and their exact areas add.
+  struct Group {
+    const TriangleSetup* key;
+    std::uint32_t coverage;
+    DepthRange range;
+  } groups[kMaxFragmentsPerPixel];
+  int n = 0, group_count = 0;
+  bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    tri[n] = pool_[f].triangle;
-    cov[n] = pool_[f].coverage;
+    const TriangleSetup* t = pool_[f].triangle;
+    DepthRange r = depth_range(*t, x, y);
     if (opaque != nullptr) {
-      DepthOrder order = compare_planes(*tri[n], *opaque, x, y);
+      DepthOrder order = r.max < opaque_range.min   ? DepthOrder::InFront
+                         : r.min >= opaque_range.max ? DepthOrder::Behind
+                                                     : order_of(*t, *opaque, x, y);
       if (order == DepthOrder::Behind) continue;  // hidden: the opaque surface came later
-      if (order == DepthOrder::Crossing) all_in_front = false;
+      if (order == DepthOrder::Crossing) crossing = true;
     }
-    if (tri[n]->surface != tri[0]->surface || tri[n]->front_facing != tri[0]->front_facing) {
-      one_surface = false;
-    }
-    depth = std::min(depth, float(tri[n]->depth_at(cx, cy)));
+    int g = 0;
+    while (g < group_count && !same_surface(*groups[g].key, *t)) ++g;
+    if (g == group_count) groups[group_count++] = Group{t, 0, r};
+    groups[g].coverage += pool_[f].coverage;
+    groups[g].range.min = std::min(groups[g].range.min, r.min);
+    groups[g].range.max = std::max(groups[g].range.max, r.max);
+    tri[n] = t;
+    cov[n] = pool_[f].coverage;
+    range[n] = r;
+    group[n] = g;
+    depth = std::min(depth, float(t->depth_at(cx, cy)));
     ++n;
   }
   if (n == 0) return behind;
 
   double weight[kMaxFragmentsPerPixel];
-  if (one_surface && all_in_front) {
-    // Disjoint pieces of one surface: the exact areas add.
-    for (int i = 0; i < n; ++i) weight[i] = double(cov[i]) / kCoverageOne;
+  int front = 0;  // the group nearest at its nearest point
+  for (int g = 1; g < group_count; ++g) {
+    if (groups[g].range.min < groups[front].range.min) front = g;
+  }
+  bool front_separate = !crossing;
+  for (int g = 0; g < group_count; ++g) {
+    if (g != front && !(groups[front].range.max < groups[g].range.min)) front_separate = false;
+  }
+  if (front_separate && (group_count == 1 || groups[front].coverage >= std::uint32_t(kCoverageOne))) {
+    // One surface in front of everything else in this pixel: its exact areas add, and when
+    // they fill the pixel nothing behind shows. (Weights are normalised below if > 1.)
+    for (int i = 0; i < n; ++i) {
+      weight[i] = group[i] == front ? double(cov[i]) / kCoverageOne : 0.0;
+    }
   } else {
     // Visibility per sub-pixel sample, with per-sample depth from each plane.
     std::uint64_t mask[kMaxFragmentsPerPixel];
@@ -225,7 +281,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
         share = double(won[i]) / samples;
       } else {
         // Too small to own a sample: visible if it is in front of the opaque surface.
-        share = opaque == nullptr || tri[i]->depth_at(cx, cy) < opaque->depth_at(cx, cy) ? 1 : 0;
+        share = opaque == nullptr || range[i].min < opaque_range.min ? 1 : 0;
       }
       weight[i] = double(cov[i]) / kCoverageOne * share;
     }

@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cmath>
+#include <limits>
 
 namespace covrast::detail {
 namespace {
@@ -21,26 +22,43 @@ std::array<float, 255> make_thresholds() {
   return t;
 }
 
-const std::array<float, 255>& thresholds() {
-  static const std::array<float, 255> t = make_thresholds();
-  return t;
+/// Buckets of the linear range: start[i] is the code of the smallest value of bucket i, so
+/// encoding is a table look-up plus at most a few threshold steps (the sRGB curve is
+/// steepest near 0, at 12.92 * 255 codes per unit: under one code per bucket).
+constexpr int kBuckets = 4096;
+
+struct Encoder {
+  std::array<float, 256> threshold;  ///< threshold[255] = +inf as a sentinel
+  std::array<std::uint8_t, kBuckets + 1> start;
+  Encoder() {
+    auto t = make_thresholds();
+    for (int k = 0; k < 255; ++k) threshold[k] = t[k];
+    threshold[255] = std::numeric_limits<float>::infinity();
+    for (int i = 0; i <= kBuckets; ++i) {
+      float lo = float(i) / kBuckets;
+      int code = 0;
+      while (threshold[code] <= lo) ++code;
+      start[i] = std::uint8_t(code);
+    }
+  }
+};
+
+const Encoder& encoder() {
+  static const Encoder e;
+  return e;
 }
 
 }  // namespace
 
 std::uint8_t encode_srgb8(float linear) {
-  const auto& t = thresholds();
-  // Count thresholds <= linear: 8 halving steps over 255 entries.
-  int lo = 0, hi = 255;
-  while (lo < hi) {
-    int mid = (lo + hi) / 2;
-    if (t[mid] <= linear) {
-      lo = mid + 1;
-    } else {
-      hi = mid;
-    }
-  }
-  return std::uint8_t(lo);
+  // The result is the number of thresholds <= linear, i.e. round(255 * srgb(linear)).
+  if (!(linear > 0.0f)) return 0;
+  if (linear >= 1.0f) return 255;
+  const Encoder& e = encoder();
+  // float(i) / kBuckets <= linear for i = floor(linear * kBuckets): exact power-of-2 scaling.
+  int code = e.start[int(linear * kBuckets)];
+  while (e.threshold[code] <= linear) ++code;
+  return std::uint8_t(code);
 }
 
 void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec3* linear,
@@ -48,10 +66,19 @@ void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec
   for (int y = rect.y0; y < rect.y1; ++y) {
     const glm::vec3* src = linear + std::size_t(y - rect.y0) * stride;
     std::uint8_t* dst = target.color->pixel(rect.x0, y);
+    // Flat-shaded scenes repeat colours along a row: reuse the last encoding.
+    glm::vec3 last(-1.0f);
+    std::uint8_t code[3] = {0, 0, 0};
     for (int x = rect.x0; x < rect.x1; ++x, ++src, dst += 3) {
-      dst[0] = encode_srgb8(src->r);
-      dst[1] = encode_srgb8(src->g);
-      dst[2] = encode_srgb8(src->b);
+      if (*src != last) {
+        last = *src;
+        code[0] = encode_srgb8(src->r);
+        code[1] = encode_srgb8(src->g);
+        code[2] = encode_srgb8(src->b);
+      }
+      dst[0] = code[0];
+      dst[1] = code[1];
+      dst[2] = code[2];
     }
     if (target.depth != nullptr && depth != nullptr) {
       const float* dsrc = depth + std::size_t(y - rect.y0) * stride;

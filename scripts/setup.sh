@@ -1,0 +1,38 @@
+#!/usr/bin/env bash
+# Installs the Debian packages covrast needs to build and test (Debian 12). Idempotent: asks
+# dpkg-query which packages are missing and installs only those; when none is missing it does
+# not call apt-get at all. Runs as root (the CI case) or through sudo when available.
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ clang pkg-config
+  libglm-dev libtbb-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null || true)
+  if [[ "$status" != "installed" ]]; then
+    missing+=("$package")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "setup: all ${#packages[@]} packages are installed"
+  exit 0
+fi
+
+if [[ $(id -u) -eq 0 ]]; then
+  as_root=()
+elif command -v sudo >/dev/null 2>&1; then
+  as_root=(sudo)
+else
+  echo "setup: error: missing packages (${missing[*]}) and not root, and sudo is not available" >&2
+  exit 1
+fi
+
+echo "setup: installing ${missing[*]}"
+"${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
+"${as_root[@]}" env DEBIAN_FRONTEND=noninteractive \
+  apt-get install -y --no-install-recommends "${missing[@]}"
