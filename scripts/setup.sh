@@ -12,8 +12,9 @@ packages=(
 
 missing=()
 for package in "${packages[@]}"; do
-  status=$(dpkg-query -W -f='${db:Status-Status}' "$package" 2>/dev/null || true)
-  if [[ "$status" != "installed" ]]; then
+  # One line per installed architecture (e.g. amd64 and i386); any "installed" one will do.
+  status=$(dpkg-query -W -f='${db:Status-Status}\n' "$package" 2>/dev/null || true)
+  if ! grep -qx installed <<<"$status"; then
     missing+=("$package")
   fi
 done

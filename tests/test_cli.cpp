@@ -332,6 +332,30 @@ TEST_CASE("cli: render of a good scene writes a PNG of the requested size", "[cl
   CHECK(pfm.compare(0, header.size(), header) == 0);
 }
 
+TEST_CASE("cli: scene warnings go to stderr; --strict makes them errors", "[cli]") {
+  TempDir dir;
+  // The second triangle has an infinite coordinate (1e400 overflows): dropped with a warning.
+  write_text(dir / "inf.obj", std::string(kTriangleObj) + "v 1e400 0 0\nf 1 2 4\n");
+  write_text(dir / "scene.json", scene_json("inf.obj"));
+  const fs::path out = dir / "out.png";
+
+  RunResult r =
+      run_cli(dir, {"render", (dir / "scene.json").string(), "-o", out.string(), "--strict"});
+  INFO("stderr: " << r.err);
+  CHECK(r.exit_code == 2);
+  CHECK(r.out.empty());
+  CHECK(r.err.rfind("warning: ", 0) == 0);
+  CHECK(r.err.find("\ncovrast: error: ") != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+
+  r = run_cli(dir, {"render", (dir / "scene.json").string(), "-o", out.string()});
+  CHECK(r.exit_code == 0);
+  CHECK(r.err.rfind("warning: ", 0) == 0);
+  CHECK(r.err.find("dropped 1 triangles") != std::string::npos);
+  CHECK(r.err.find("covrast: error") == std::string::npos);
+  CHECK(fs::exists(out));
+}
+
 TEST_CASE("cli: info describes a good scene", "[cli]") {
   TempDir dir;
   write_good_scene(dir);

@@ -15,6 +15,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -76,28 +77,30 @@ struct ObjMesh {
 };
 
 /// Minimal OBJ reader for the generator's output: "v x y z [r g b]" and "f a b c" (1-based).
+/// Throws std::runtime_error naming the file and line on anything else, which fails the test.
 ObjMesh parse_obj(const fs::path& path) {
   ObjMesh mesh;
   std::istringstream lines(read_bytes(path));
   std::string line;
+  int line_number = 0;
+  const auto malformed = [&path, &line_number](const char* problem) {
+    return std::runtime_error(path.string() + ":" + std::to_string(line_number) + ": " + problem);
+  };
   while (std::getline(lines, line)) {
+    ++line_number;
     std::istringstream fields(line);
     std::string tag;
     fields >> tag;
     if (tag == "v") {
       std::array<double, 3> p{};
-      fields >> p[0] >> p[1] >> p[2];
-      REQUIRE(fields);
+      if (!(fields >> p[0] >> p[1] >> p[2])) throw malformed("bad vertex");
       mesh.positions.push_back(p);
     } else if (tag == "f") {
       std::array<std::uint32_t, 3> t{};
-      fields >> t[0] >> t[1] >> t[2];
-      REQUIRE(fields);
       std::string extra;
-      REQUIRE_FALSE(fields >> extra);  // triangles only
+      if (!(fields >> t[0] >> t[1] >> t[2]) || fields >> extra) throw malformed("not a triangle");
       for (auto& index : t) {
-        REQUIRE(index >= 1);
-        REQUIRE(index <= mesh.positions.size());
+        if (index < 1 || index > mesh.positions.size()) throw malformed("index out of range");
         --index;
       }
       mesh.triangles.push_back(t);

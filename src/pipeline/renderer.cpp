@@ -244,8 +244,14 @@ std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int
       return make_coverage_rasterizer(tile_px, false);
     case ModeKind::CoverageBlend:
       return make_coverage_rasterizer(tile_px, true);
-    default:
-      break;
+    case ModeKind::Ssaa:
+      return make_ssaa_rasterizer(tile_px, mode.samples, false);
+    case ModeKind::SsaaGrid:
+      return make_ssaa_rasterizer(tile_px, mode.samples, true);
+    case ModeKind::Msaa:
+      return make_msaa_rasterizer(tile_px, mode.samples);
+    case ModeKind::Reference:
+      return make_reference_rasterizer(tile_px);
   }
   throw InputError("mode '" + to_string(mode) + "' is not available in this build yet");
 }

@@ -1,0 +1,99 @@
+// Raster stage, sample-based modes (ssaa, ssaa-grid, msaa): one rasterizer parameterised
+// by its sample pattern and shading rate.
+//
+// Per tile it keeps, for every sample, a float depth and a fixed-point linear colour
+// (sample_kernel.hpp), pixel-major. The tile is rasterized in horizontal bands whose
+// sample buffers fit `band_budget_bytes` (sized to stay in the core's L2 cache): when the
+// whole tile fits, triangles are rasterized as they arrive; otherwise draw() only records
+// them and end_tile() replays each band's triangles, in draw order, band after band.
+// Resolve: the box filter, i.e. the mean linear colour over the pixel's samples, then
+// 8-bit sRGB.
+#pragma once
+
+#include "raster/sample_kernel.hpp"
+#include "raster/sample_pattern.hpp"
+#include "raster/tile_raster.hpp"
+
+#include <hwy/aligned_allocator.h>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace covrast::detail {
+
+enum class ShadingRate {
+  PerSample,  ///< ssaa: shade() at every sample position
+  PerPixel,   ///< msaa: shade() once per pixel and triangle, at the centre, clamped inside
+};
+
+/// Default band budget: four sample buffers of at most 512 KiB together.
+inline constexpr std::size_t kDefaultBandBudgetBytes = std::size_t(512) << 10;
+
+class SampleRasterizer final : public TileRasterizer {
+ public:
+  /// `pattern` must use unit 256 and hold 1..256 samples.
+  SampleRasterizer(int tile_px, const SamplePattern& pattern, ShadingRate rate,
+                   const SampleKernels& kernels,
+                   std::size_t band_budget_bytes = kDefaultBandBudgetBytes);
+  ~SampleRasterizer() override;
+
+  void begin_tile(const PixelRect& rect, const FrameTarget& target) override;
+  void draw(const TriangleSetup& triangle) override;
+  void end_tile(const FrameTarget& target) override;
+  std::size_t scratch_bytes() const override;
+
+  /// What end_tile does before encoding: rasterizes what is pending and resolves the
+  /// tile. Afterwards pixel (x, y) of the tile has linear colour
+  /// linear()[(y - y0) * tile_px + (x - x0)] (and depth() likewise when depth is wanted).
+  void resolve_tile(const FrameTarget& target);
+  const glm::vec3* linear() const { return linear_.data(); }
+  const float* depth() const { return pixel_depth_.data(); }
+  int band_rows() const { return band_rows_; }
+
+ private:
+  struct Pending {
+    const TriangleSetup* triangle;
+    PixelRect rect;
+  };
+  void start_band(int y0, int y1);
+  void rasterize(const TriangleSetup& t, const PixelRect& r);
+  void sample_wide(const TriangleSetup& t, const std::int64_t f[3], float z_base,
+                   const std::uint32_t* rgb, const GroupSamples& out, std::uint64_t* written);
+  void shade_written(const TriangleSetup& t, int gx, int y, const std::uint64_t* written,
+                     const GroupSamples& out);
+  void resolve_band();
+
+  int tile_px_;
+  ShadingRate rate_;
+  SampleKernels kernels_;
+  std::unique_ptr<GroupPattern> pattern_;
+  std::unique_ptr<GroupTriangle> tri_;
+  SamplePattern pixel_pattern_;  ///< the S per-pixel offsets [fx8]
+  int buffer_px_;                ///< pixels per buffer row, a multiple of G
+  int band_rows_;
+  std::size_t row_lanes_;  ///< buffer_px_ * P
+  hwy::AlignedFreeUniquePtr<float[]> depth_;
+  hwy::AlignedFreeUniquePtr<std::uint32_t[]> r_, g_, b_;
+  std::vector<std::uint32_t> sums_;
+  std::vector<float> min_depth_;
+  std::vector<glm::vec3> linear_;
+  std::vector<float> pixel_depth_;
+  std::vector<Pending> pending_;
+  std::vector<std::uint32_t> band_begin_;
+  std::vector<std::uint32_t> band_items_;
+  std::vector<std::uint32_t> band_cursor_;
+
+  PixelRect rect_;
+  int buffer_x0_ = 0;  ///< absolute x of buffer column 0: rect_.x0 rounded down to G
+  int band_y0_ = 0;
+  int band_y1_ = 0;
+  bool immediate_ = true;
+  bool want_depth_ = false;
+  std::uint32_t background_q_[3] = {0, 0, 0};
+};
+
+/// Fixed-point linear colour of sample_kernel.hpp: round(clamp(c, 0, 1) * 2^23).
+std::uint32_t quantize_color(float linear);
+
+}  // namespace covrast::detail
