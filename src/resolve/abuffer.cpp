@@ -202,8 +202,8 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   std::uint32_t cov[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
   int group[kMaxFragmentsPerPixel];
-  // Fragments of one surface (mesh instance and facing) form a group: in one pixel they
-  // are adjacent pieces of a tessellation, and their exact areas add.
+  // Fragments of one layer of one surface form a group: in one pixel they are adjacent
+  // pieces of a tessellation, and their exact areas add.
   struct Group {
     const TriangleSetup* key;
     std::uint32_t coverage;
@@ -221,8 +221,15 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
       if (order == DepthOrder::Behind) continue;  // hidden: the opaque surface came later
       if (order == DepthOrder::Crossing) crossing = true;
     }
+    // A group is one layer: the same surface, and depth ranges that meet (adjacent pieces of
+    // a tessellation share an edge inside the pixel, so their ranges overlap). Two parts of
+    // one mesh at different depths (a fold in front of the back) are different layers.
     int g = 0;
-    while (g < group_count && !same_surface(*groups[g].key, *t)) ++g;
+    while (g < group_count &&
+           !(same_surface(*groups[g].key, *t) &&
+             !(r.max < groups[g].range.min || groups[g].range.max < r.min))) {
+      ++g;
+    }
     if (g == group_count) groups[group_count++] = Group{t, 0, r};
     groups[g].coverage += pool_[f].coverage;
     groups[g].range.min = std::min(groups[g].range.min, r.min);
