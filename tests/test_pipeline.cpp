@@ -140,9 +140,9 @@ std::vector<glm::dvec4> clip_against(const std::vector<glm::dvec4>& poly, glm::d
   return out;
 }
 
-/// The exact screen polygon [pixels] of a world triangle: clipped against the near and far
-/// planes (z = -w and z = w) in homogeneous space, then projected. Empty when invisible.
-std::vector<glm::dvec2> reference_polygon(const Scene& scene, const std::array<glm::dvec3, 3>& v) {
+/// The exact screen polygon [pixels] of a convex world polygon: clipped against the near and
+/// far planes (z = -w and z = w) in homogeneous space, then projected. Empty when invisible.
+std::vector<glm::dvec2> reference_polygon(const Scene& scene, const std::vector<glm::dvec3>& v) {
   glm::dmat4 vp = view_projection(scene);
   std::vector<glm::dvec4> poly;
   for (const glm::dvec3& p : v) poly.push_back(vp * glm::dvec4(p, 1.0));
@@ -155,6 +155,10 @@ std::vector<glm::dvec2> reference_polygon(const Scene& scene, const std::array<g
                         (1.0 - c.y / c.w) * 0.5 * scene.height);
   }
   return screen;
+}
+
+std::vector<glm::dvec2> reference_polygon(const Scene& scene, const std::array<glm::dvec3, 3>& v) {
+  return reference_polygon(scene, std::vector<glm::dvec3>(v.begin(), v.end()));
 }
 
 double cross2(glm::dvec2 a, glm::dvec2 b) { return a.x * b.y - a.y * b.x; }
@@ -608,6 +612,115 @@ TEST_CASE("guard-band clipping: huge triangles render like moderate ones", "[pip
   }
 }
 
+TEST_CASE("a tessellated floor crossing the near plane stays watertight", "[pipeline]") {
+  // The camera of scenes/near_plane.json; a 12 x 15 floor at y = -0.5 from behind the eye
+  // (z = 3) to z = -12, as a jittered grid: many shared edges are clipped by the near plane.
+  Scene scene;
+  scene.width = 160;
+  scene.height = 90;
+  scene.background_linear = glm::vec3(0.0f);
+  scene.camera.eye = glm::dvec3(0.0);
+  scene.camera.target = glm::dvec3(0.0, -0.15, -1.0);
+  scene.camera.fovy_deg = 60.0;
+  scene.camera.near = 0.1;
+  scene.camera.far = 50.0;
+  const int cols = 12, rows = 15;
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> jitter(-0.2f, 0.2f);
+  std::vector<glm::vec3> positions;
+  for (int r = 0; r <= rows; ++r) {
+    for (int c = 0; c <= cols; ++c) {
+      glm::vec3 p(-6.0f + float(c), -0.5f, 3.0f - float(r));
+      if (c > 0 && c < cols && r > 0 && r < rows) {
+        p.x += jitter(rng);
+        p.z += jitter(rng);
+      }
+      positions.push_back(p);
+    }
+  }
+  std::vector<std::uint32_t> indices;
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c < cols; ++c) {
+      std::uint32_t a = std::uint32_t(r * (cols + 1) + c), b = a + 1, d = a + cols + 1, e = d + 1;
+      indices.insert(indices.end(), {a, d, e, a, e, b});
+    }
+  }
+  auto mesh = make_mesh(positions, indices);
+  std::vector<glm::dvec2> poly = reference_polygon(
+      scene, {{-6.0, -0.5, 3.0}, {-6.0, -0.5, -12.0}, {6.0, -0.5, -12.0}, {6.0, -0.5, 3.0}});
+  REQUIRE(poly.size() >= 3);
+
+  SECTION("aliased: one colour, no cracks, nothing outside") {
+    Scene uniform = scene;
+    add_instance(uniform, mesh, ColorSource::Uniform, glm::vec3(1.0f));
+    RenderResult result = render_with(uniform, "aliased");
+    CHECK(result.stats.triangles_clipped > 10);
+    PolygonCheck check = check_polygon(result.color, poly, {255, 255, 255}, {0, 0, 0}, 1.0 / 128);
+    INFO(check.first_wrong);
+    CHECK(check.wrong == 0);
+    CHECK(check.inside > 3000);
+    CHECK(check.undecided < 40);
+  }
+
+  SECTION("aliased: no pixel owned twice (draw order reversed)") {
+    std::vector<glm::vec3> soup, colors;
+    std::vector<std::uint32_t> forward, backward;
+    const std::size_t n = indices.size() / 3;
+    for (std::size_t t = 0; t < n; ++t) {
+      std::uint32_t hash = lowbias32(std::uint32_t(t));
+      glm::vec3 color(float(hash & 255) / 255.0f, float(hash >> 8 & 255) / 255.0f,
+                      float(hash >> 16 & 255) / 255.0f);
+      for (int j = 0; j < 3; ++j) {
+        soup.push_back(positions[indices[3 * t + j]]);
+        colors.push_back(color);
+      }
+    }
+    for (std::size_t t = 0; t < n; ++t) {
+      for (int j = 0; j < 3; ++j) {
+        forward.push_back(std::uint32_t(3 * t + j));
+        backward.push_back(std::uint32_t(3 * (n - 1 - t) + j));
+      }
+    }
+    Scene a = scene, b = scene;
+    add_instance(a, make_mesh(soup, forward, colors), ColorSource::Vertex);
+    add_instance(b, make_mesh(soup, backward, colors), ColorSource::Vertex);
+    ImageDiff d = diff_images(render_with(a, "aliased").color, render_with(b, "aliased").color);
+    INFO(d.first);
+    CHECK(d.count == 0);
+  }
+
+  SECTION("coverage: pixels wholly inside are exactly the surface colour") {
+    Scene uniform = scene;
+    add_instance(uniform, mesh, ColorSource::Uniform, glm::vec3(1.0f));
+    Image image = render_with(uniform, "coverage").color;
+    // A pixel square lies wholly inside (outside) when its centre is inside (outside) and
+    // more than half a diagonal, 0.7072 px, from the boundary.
+    std::size_t inside = 0, outside = 0, wrong = 0;
+    std::string first;
+    for (int y = 0; y < image.height; ++y) {
+      for (int x = 0; x < image.width; ++x) {
+        glm::dvec2 c(x + 0.5, y + 0.5);
+        double distance = 1e300;
+        for (std::size_t k = 0; k < poly.size(); ++k) {
+          distance = std::min(distance, segment_distance(c, poly[k], poly[(k + 1) % poly.size()]));
+        }
+        if (distance < 0.7072) continue;
+        bool in = inside_convex(poly, c);
+        (in ? inside : outside)++;
+        Rgb expected = in ? Rgb{255, 255, 255} : Rgb{0, 0, 0};
+        if (pixel_at(image, x, y) != expected && wrong++ == 0) {
+          first = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is " +
+                  describe(pixel_at(image, x, y)) + ", expected " + describe(expected);
+        }
+      }
+    }
+    INFO(first);
+    CHECK(wrong == 0);
+    CHECK(inside > 3000);
+    CHECK(outside > 3000);
+  }
+}
+
 // ---------------------------------------------------------------------------------------
 // 2. Watertightness and the top-left rule (aliased)
 // ---------------------------------------------------------------------------------------
@@ -928,8 +1041,75 @@ TEST_CASE("images are byte-identical for every thread count and tile size", "[pi
     options.tile = 16;
     Renderer renderer(scene, options);
     RenderResult first = renderer.render_frame();
-    for (int i = 0; i < 3; ++i) CHECK(renderer.render_frame().color.rgb == first.color.rgb);
+    for (int i = 0; i < 3; ++i) {
+      RenderResult again = renderer.render_frame();
+      CHECK(again.color.rgb == first.color.rgb);
+      CHECK(again.stats.triangles_in == first.stats.triangles_in);
+      CHECK(again.stats.triangles_culled == first.stats.triangles_culled);
+      CHECK(again.stats.triangles_clipped == first.stats.triangles_clipped);
+      CHECK(again.stats.triangles_setup == first.stats.triangles_setup);
+      CHECK(again.stats.bin_entries == first.stats.bin_entries);
+      CHECK(again.stats.fragment_overflows == first.stats.fragment_overflows);
+    }
   }
+}
+
+TEST_CASE("odd image sizes render the same for every tile size", "[pipeline]") {
+  for (auto [w, h] : {std::pair{1, 1}, std::pair{7, 300}, std::pair{300, 9}, std::pair{257, 65}}) {
+    Scene scene = pixel_scene(w, h);
+    std::mt19937 rng(std::uint32_t(w * 1000 + h));
+    std::uniform_real_distribution<float> ux(-w / 2.0f - 5.0f, w / 2.0f + 5.0f);
+    std::uniform_real_distribution<float> uy(-h / 2.0f - 5.0f, h / 2.0f + 5.0f);
+    std::vector<glm::vec3> positions;
+    std::vector<std::uint32_t> indices;
+    for (std::uint32_t k = 0; k < 3 * 40; ++k) {
+      positions.emplace_back(ux(rng), uy(rng), 0.0f);
+      indices.push_back(k);
+    }
+    add_instance(scene, make_mesh(positions, indices), ColorSource::PerTriangle);
+    for (const char* mode : {"aliased", "coverage"}) {
+      Image reference = render_with(scene, mode, 1, 8).color;
+      CHECK(reference.rgb.size() == std::size_t(w) * h * 3);
+      for (int tile : {16, 64, 256}) {
+        INFO(w << "x" << h << ", " << mode << ", tile " << tile);
+        CHECK(render_with(scene, mode, 2, tile).color.rgb == reference.rgb);
+      }
+    }
+  }
+}
+
+TEST_CASE("an empty scene renders the background", "[pipeline]") {
+  Scene scene = pixel_scene(50, 30);
+  scene.background_linear = glm::vec3(1.0f, 0.0f, 1.0f);
+  for (const char* mode : {"aliased", "coverage", "coverage-blend"}) {
+    RenderResult r = render_with(scene, mode, 0, 16, true);
+    INFO(mode);
+    CHECK(r.stats.triangles_in == 0);
+    CHECK(r.stats.bin_entries == 0);
+    CHECK(r.color.rgb.size() == 50u * 30u * 3u);
+    bool all_magenta = true;
+    for (int y = 0; y < 30; ++y)
+      for (int x = 0; x < 50; ++x) all_magenta &= pixel_at(r.color, x, y) == Rgb{255, 0, 255};
+    CHECK(all_magenta);
+    CHECK(r.depth.depth == std::vector<float>(50 * 30, 1.0f));
+  }
+}
+
+TEST_CASE("per_triangle colours use the global triangle index over all meshes", "[pipeline]") {
+  Scene scene = pixel_scene(160, 90);
+  // Mesh 0: two small triangles on the left; mesh 1: one triangle on the right.
+  add_instance(
+      scene,
+      make_mesh(
+          {{-70, -10, 0}, {-50, -10, 0}, {-70, 10, 0}, {-40, 30, 0}, {-30, 30, 0}, {-40, 40, 0}},
+          {0, 1, 2, 3, 4, 5}),
+      ColorSource::Uniform);
+  add_instance(scene, make_mesh({{20, -20, 0}, {60, -20, 0}, {20, 20, 0}}, {0, 1, 2}),
+               ColorSource::PerTriangle);
+  Image image = render_with(scene, "aliased").color;
+  // World (25, 0) is pixel (105, 45), inside mesh 1's triangle, global index 2.
+  CHECK(pixel_at(image, 105, 45) == per_triangle_rgb(2));
+  CHECK(pixel_at(image, 105, 45) != per_triangle_rgb(0));
 }
 
 // ---------------------------------------------------------------------------------------
