@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -133,12 +134,13 @@ std::shared_ptr<MeshData> uv_sphere(int stacks, int slices) {
   return m;
 }
 
-/// n x n cells over [x0, x1] x [y0, y1] (pixels) at depth 0, interior vertices jittered.
+/// n x n cells over [x0, x1] x [y0, y1] (pixels) at depth 0, interior vertices jittered by up
+/// to 0.2 cell (below 0.25: every cell stays convex, no triangle folds over).
 std::shared_ptr<MeshData> tessellated_square(const Scene& s, double x0, double y0, double x1,
                                              double y1, int n, std::uint32_t seed) {
   std::mt19937 rng(seed);
   const double cw = (x1 - x0) / n, ch = (y1 - y0) / n;
-  std::uniform_real_distribution<double> jx(-0.35 * cw, 0.35 * cw), jy(-0.35 * ch, 0.35 * ch);
+  std::uniform_real_distribution<double> jx(-0.2 * cw, 0.2 * cw), jy(-0.2 * ch, 0.2 * ch);
   auto m = std::make_shared<MeshData>();
   m->source = "tessellated square";
   for (int j = 0; j <= n; ++j) {
@@ -329,11 +331,16 @@ struct Comparison {
   std::string worst;
 };
 
-Comparison compare(const Image& img, const ReferenceImage& ref) {
+/// Product against reference over the pixels `include` accepts (all when empty).
+Comparison compare(const Image& img, const ReferenceImage& ref,
+                   const std::function<bool(int, int)>& include = {}) {
   Comparison c;
   double sum = 0;
+  int counted = 0;
   for (int y = 0; y < img.height; ++y) {
     for (int x = 0; x < img.width; ++x) {
+      if (include && !include(x, y)) continue;
+      ++counted;
       const std::uint8_t* p = img.pixel(x, y);
       const glm::dvec3 r = ref.linear[std::size_t(y) * ref.width + x];
       bool differs = false;
@@ -354,7 +361,7 @@ Comparison compare(const Image& img, const ReferenceImage& ref) {
       c.pixels_differing += differs ? 1 : 0;
     }
   }
-  c.mean_diff8 = sum / (3.0 * img.width * img.height);
+  c.mean_diff8 = counted > 0 ? sum / (3.0 * counted) : 0.0;
   return c;
 }
 
@@ -494,9 +501,18 @@ TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]
   }
 }
 
+/// Tolerance against the 64 x 64-sample reference where the resolve uses its 8 x 8 sub-pixel
+/// masks, in linear light per channel. A straight edge through the 8 mask columns can
+/// misplace up to 1/8 of a pixel; fragments in these scenes stay within 1/32 (measured up
+/// to about 0.02). In 8-bit sRGB the same error reads large in dark channels (0.02 linear is
+/// 39 codes at 0), so the 8-bit measure is reported, and bounded only on average.
+constexpr double kMaskToleranceLinear = 1.0 / 32.0;
+
 TEST_CASE("coverage mode: a silhouette blends with the surface behind it", "[coverage]") {
   // Front green triangle (depth 0.5) over a large blue quad (depth 0) whose diagonal crosses
-  // the green edges; background black. The edges must mix green and blue only.
+  // the green edges; background black. The edges must mix green and blue only. Where the
+  // only partial fragment is green (the pixel is not on the blue diagonal) the resolve is
+  // analytic: within 1 code of the reference.
   const glm::vec3 green(0, 1, 0), blue(0, 0, 1);
   for (bool green_first : {true, false}) {
     Scene s = make_scene(64, 48, glm::vec3(0));
@@ -514,19 +530,35 @@ TEST_CASE("coverage mode: a silhouette blends with the surface behind it", "[cov
       add_instance(s, b, blue);
       add_instance(s, g, green);
     }
-    const ReferenceImage ref = reference_render(s, screen_triangles(s));
+    const std::uint32_t blue_surface = green_first ? 1 : 0;
+    const std::vector<TriangleSetup> tris = screen_triangles(s);
+    REQUIRE(tris.size() == 3);
+    const ReferenceImage ref = reference_render(s, tris);
     const Image img = render(s, ModeKind::Coverage).color;
-    const Comparison c = compare(img, ref);
-    // No darkening: linear green + blue = 1 within the 8-bit steps (0.5 of a step each,
-    // 0.0044 linear near 1), and no red.
-    double worst_sum = 0;
+    auto off_diagonal = [&](int x, int y) {
+      int blue_touching = 0;
+      for (const TriangleSetup& t : tris) {
+        RefTriangle r{{double(t.x_fx8[0]), double(t.x_fx8[1]), double(t.x_fx8[2])},
+                      {double(t.y_fx8[0]), double(t.y_fx8[1]), double(t.y_fx8[2])},
+                      &t};
+        if (t.surface == blue_surface && !r.misses_pixel(x, y)) ++blue_touching;
+      }
+      return blue_touching <= 1;
+    };
+    const Comparison all = compare(img, ref);
+    const Comparison analytic = compare(img, ref, off_diagonal);
+    // No darkening: linear green + blue = 1 within the 8-bit steps (half a step each, at
+    // most 0.0044 + 0.0044 linear near 1) plus the mask tolerance on the blue diagonal; no red.
+    double worst_sum = 1;
+    int red = 0;
     std::string where;
     for (int y = 0; y < img.height; ++y) {
       for (int x = 0; x < img.width; ++x) {
         const std::uint8_t* p = img.pixel(x, y);
+        red += p[0] != 0 ? 1 : 0;
         const double sum =
             covrast::srgb_to_linear(p[1] / 255.0f) + covrast::srgb_to_linear(p[2] / 255.0f);
-        if (std::fabs(sum - 1.0) > std::fabs(worst_sum - 1.0) || p[0] != 0) {
+        if (std::fabs(sum - 1.0) > std::fabs(worst_sum - 1.0)) {
           worst_sum = sum;
           std::ostringstream o;
           o << "pixel (" << x << ", " << y << ") = (" << int(p[0]) << ", " << int(p[1]) << ", "
@@ -545,21 +577,25 @@ TEST_CASE("coverage mode: a silhouette blends with the surface behind it", "[cov
         blend_dark += sum < 0.95 ? 1 : 0;
       }
     }
-    WARN("silhouette, green drawn " << (green_first ? "first" : "last") << ": " << describe(c)
-                                    << "; worst green + blue (linear) " << worst_sum << " at "
-                                    << where
-                                    << "; coverage-blend pixels darker than 0.95: " << blend_dark);
-    CHECK(c.max_diff8 <= 2);
-    CHECK(c.mean_diff8 < 0.05);
+    WARN("silhouette, green drawn "
+         << (green_first ? "first" : "last") << ": all pixels: " << describe(all)
+         << "; off the blue diagonal: " << describe(analytic) << "; worst green + blue (linear) "
+         << worst_sum << " at " << where
+         << "; coverage-blend pixels darker than 0.95: " << blend_dark);
+    CHECK(analytic.max_diff8 <= 1);
+    CHECK(all.max_diff_linear <= kMaskToleranceLinear);
+    CHECK(all.mean_diff8 < 0.05);
+    CHECK(red == 0);
     CHECK(std::fabs(worst_sum - 1.0) <= 0.009);
-    if (green_first) CHECK(blend_dark > 10);  // the seed's black edge: the test can fail
+    // The seed's black edge when the front is drawn first: the test above can fail.
+    if (green_first) CHECK(blend_dark > 10);
   }
 }
 
 TEST_CASE("coverage mode: a partial occluder hides only where it covers", "[coverage]") {
   // Red triangle in front (depth 0.5), blue behind (depth 0), their edges crossing inside
   // the same pixels; background black. Drawn as two meshes and as one mesh (one surface,
-  // one facing: the overlap is then inside one surface).
+  // one facing: the overlap is then a fold of one surface).
   const glm::vec3 red(1, 0, 0), blue(0, 0, 1);
   const std::vector<ScreenVertex> front = {{8.2, 6.1, 0.5}, {50.7, 14.3, 0.5}, {15.4, 40.8, 0.5}};
   const std::vector<ScreenVertex> back = {{20.3, 4.4, 0}, {58.1, 36.9, 0}, {6.6, 30.2, 0}};
@@ -578,36 +614,82 @@ TEST_CASE("coverage mode: a partial occluder hides only where it covers", "[cove
       add_instance(s, screen_mesh(s, first), c1);
       add_instance(s, screen_mesh(s, second), c2);
     }
-    const ReferenceImage ref = reference_render(s, screen_triangles(s));
-    const Image img = render(s, ModeKind::Coverage).color;
-    const Comparison c = compare(img, ref);
-    INFO((one_mesh ? "one mesh" : "two meshes")
-         << ", " << (front_first ? "front" : "back") << " drawn first: " << describe(c));
-    WARN("partial occluder, " << (one_mesh ? "one mesh" : "two meshes") << ", "
-                              << (front_first ? "front" : "back") << " first: " << describe(c));
-    // Mask resolution: the 8 x 8 sub-pixel masks decide where the occluder covers; a line
-    // through 8 mask columns misplaces at most 1/8 of a pixel in linear light.
-    CHECK(c.max_diff_linear <= 0.125 + 0.005);
-    CHECK(c.mean_diff8 < 0.25);
+    const std::vector<TriangleSetup> tris = screen_triangles(s);
+    REQUIRE(tris.size() == 2);
+    REQUIRE(tris[0].front_facing == tris[1].front_facing);
+    const Comparison c = compare(render(s, ModeKind::Coverage).color, reference_render(s, tris));
+    const std::string name = std::string(one_mesh ? "one mesh" : "two meshes") + ", " +
+                             (front_first ? "front" : "back") + " drawn first";
+    INFO(name << ": " << describe(c));
+    WARN("partial occluder, " << name << ": " << describe(c));
+    CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+    CHECK(c.mean_diff8 < 0.05);
   }
+}
+
+TEST_CASE("coverage mode: a steep fold of one mesh hides the part behind it", "[coverage]") {
+  // One mesh, one facing. F covers x < 30.5 of column 30 and is steep in depth (window
+  // depth +0.04 per pixel to the right); B covers y < 20.5 of row 20 at a constant depth
+  // that F's plane reaches only right of x = 30.5, outside F. In pixel (30, 20) F is in
+  // front of B wherever both are: red 1/2 (left half), blue 1/4 (top right), black 1/4.
+  // Over the whole pixel, F's plane spans B's depth, so depth ranges alone cannot tell the
+  // two pieces apart from adjacent pieces of one layer.
+  Scene s = make_scene(64, 48, glm::vec3(0));
+  // Window depth of a vertex at world z (near 1, far 20, eye at 10): 20/19 (1 - 1/(10 - z)).
+  const std::vector<ScreenVertex> f = {{30.5, 5.0, 0.0}, {20.0, 20.0, 8.0}, {30.5, 35.0, 0.0}};
+  const std::vector<ScreenVertex> b = {
+      {10.0, 20.5, -1.37}, {50.0, 20.5, -1.37}, {30.0, 2.0, -1.37}};
+  std::vector<ScreenVertex> v = f;
+  v.insert(v.end(), b.begin(), b.end());
+  const glm::vec3 red(1, 0, 0), blue(0, 0, 1);
+  add_instance(s, screen_mesh(s, v, {red, red, red, blue, blue, blue}), glm::vec3(1),
+               ColorSource::Vertex);
+  const std::vector<TriangleSetup> tris = screen_triangles(s);
+  REQUIRE(tris.size() == 2);
+  REQUIRE(tris[0].front_facing == tris[1].front_facing);
+  // The set-up this case is about: F in front of B on F's part of pixel (30, 20) (x <= 30.5),
+  // F behind B at the pixel's right corners.
+  const double zf_left = tris[0].depth_at(30.0, 20.0), zf_mid = tris[0].depth_at(30.5, 20.0);
+  const double zf_right = tris[0].depth_at(31.0, 20.0), zb = tris[1].depth_at(30.5, 20.0);
+  INFO("F depth " << zf_left << " .. " << zf_mid << " .. " << zf_right << ", B depth " << zb);
+  REQUIRE(zf_mid < zb);
+  REQUIRE(zf_right > zb);
+  const ReferenceImage ref = reference_render(s, tris);
+  const Image img = render(s, ModeKind::Coverage).color;
+  const Comparison c = compare(img, ref);
+  const std::uint8_t* p = img.pixel(30, 20);
+  const glm::dvec3 r = ref.linear[std::size_t(20) * 64 + 30];
+  WARN("steep fold: " << describe(c) << "; pixel (30, 20) = (" << int(p[0]) << ", " << int(p[1])
+                      << ", " << int(p[2]) << "), reference (" << encode8(r.r) << ", "
+                      << encode8(r.g) << ", " << encode8(r.b) << ")");
+  CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+  CHECK(c.mean_diff8 < 0.05);
 }
 
 TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sample", "[coverage]") {
   // Two large triangles tilted in depth in opposite directions: they cross along a line
-  // through the image. Background black.
-  Scene s = make_scene(64, 48, glm::vec3(0));
-  add_instance(s, screen_mesh(s, {{-10.5, -8.25, 0.9}, {80.75, 2.5, -0.9}, {5.25, 70.5, 0.9}}),
-               glm::vec3(1, 0, 0));
-  add_instance(s, screen_mesh(s, {{-12.5, 3.5, -0.7}, {75.5, -9.25, 0.8}, {60.25, 66.75, 0.6}}),
-               glm::vec3(0, 0.5f, 1));
-  const ReferenceImage ref = reference_render(s, screen_triangles(s));
-  const Image img = render(s, ModeKind::Coverage).color;
-  const Comparison c = compare(img, ref);
-  WARN("interpenetrating: " << describe(c));
-  // Depth is resolved on the 8 x 8 mask: at most 1/8 of a pixel misassigned (linear).
-  CHECK(c.max_diff_linear <= 0.125 + 0.005);
-  CHECK(c.mean_diff8 < 0.25);
-  CHECK(c.pixels_differing < 200);
+  // through the image. Background black. As two meshes, and as one (a self-intersection).
+  const std::vector<ScreenVertex> a = {{-10.5, -8.25, 0.9}, {80.75, 2.5, -0.9}, {5.25, 70.5, 0.9}};
+  const std::vector<ScreenVertex> b = {{-12.5, 3.5, -0.7}, {75.5, -9.25, 0.8}, {60.25, 66.75, 0.6}};
+  const glm::vec3 red(1, 0, 0), sky(0, 0.5f, 1);
+  for (bool one_mesh : {false, true}) {
+    Scene s = make_scene(64, 48, glm::vec3(0));
+    if (one_mesh) {
+      std::vector<ScreenVertex> v = a;
+      v.insert(v.end(), b.begin(), b.end());
+      add_instance(s, screen_mesh(s, v, {red, red, red, sky, sky, sky}), glm::vec3(1),
+                   ColorSource::Vertex);
+    } else {
+      add_instance(s, screen_mesh(s, a), red);
+      add_instance(s, screen_mesh(s, b), sky);
+    }
+    const std::vector<TriangleSetup> tris = screen_triangles(s);
+    REQUIRE(tris.size() == 2);
+    const Comparison c = compare(render(s, ModeKind::Coverage).color, reference_render(s, tris));
+    WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes") << ": " << describe(c));
+    CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+    CHECK(c.mean_diff8 < 0.1);
+  }
 }
 
 // ---- 5. Determinism -------------------------------------------------------------------------

@@ -626,9 +626,9 @@ TEST_CASE("glTF with a data: URI buffer, node hierarchy and COLOR_0", "[scene]")
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write_json("bad_index.gltf", bad_index)),
                       Contains("bad_index.gltf") && Contains("index 7 out of range (3 vertices)"));
 
-  // Malformed glTF JSON.
-  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("broken.gltf", "{\"asset\": ")),
-                      Contains("broken.gltf"));
+  // Malformed glTF JSON: reported with line and column like a scene file.
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("broken.gltf", "{\"asset\":\n  ]")),
+                      Contains("broken.gltf:2:3: ") && Contains("unexpected ']'"));
 }
 
 TEST_CASE("binary glTF (.glb) with a node matrix, float COLOR_0 and a NaN vertex", "[scene]") {

@@ -29,17 +29,34 @@ constexpr std::size_t kMaxUnbackedElements = std::size_t{1} << 26;
   throw InputError(name + ": " + message);
 }
 
-/// tinygltf's messages can span several lines; ours are one line.
-std::string one_line(std::string text) {
+/// tinygltf's messages can span several lines and quote raw bytes; ours are one printable
+/// line. A JSON syntax error ("... parse error at line L, column C: detail") becomes
+/// "name:L:C: detail", like the scene file's own syntax errors.
+std::string loader_error_message(const std::string& name, std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r' || text.back() == ' ')) {
     text.pop_back();
   }
-  std::string out;
+  if (text.empty()) return name + ": cannot parse glTF";
+  std::string position;
+  const std::string marker = "parse error at line ";
+  if (const std::size_t at = text.find(marker); at != std::string::npos) {
+    const std::size_t comma = text.find(", column ", at);
+    const std::size_t colon = comma == std::string::npos ? comma : text.find(": ", comma);
+    if (colon != std::string::npos) {
+      const std::size_t line_begin = at + marker.size();
+      const std::size_t column_begin = comma + 9;
+      position = ":" + text.substr(line_begin, comma - line_begin) + ":" +
+                 text.substr(column_begin, colon - column_begin);
+      text = text.substr(colon + 2);
+    }
+  }
+  std::string out = name + position + ": ";
   for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
     if (c == '\n') {
       out += "; ";
     } else if (c != '\r') {
-      out += c;
+      out += (byte < 0x20 || byte >= 0x7f) ? '?' : c;
     }
   }
   return out;
@@ -296,7 +313,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                                         static_cast<unsigned>(bytes.size()), base_dir.string())
           : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                        static_cast<unsigned>(bytes.size()), base_dir.string());
-  if (!ok) fail(name, err.empty() ? std::string("cannot parse glTF") : one_line(err));
+  if (!ok) throw InputError(loader_error_message(name, err));
 
   const Reader reader{model, name};
   const std::size_t node_count = model.nodes.size();

@@ -58,8 +58,10 @@ json parse_json(const std::string& text, const std::string& file) {
         detail = detail.substr(colon + 2);
       }
     }
+    // The detail quotes what was read, which may be control bytes or broken UTF-8.
     for (char& c : detail) {
-      if (c == '\n' || c == '\r') c = ' ';
+      const auto byte = static_cast<unsigned char>(c);
+      if (byte < 0x20 || byte >= 0x7f) c = '?';
     }
     throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
                      detail);
