@@ -508,6 +508,95 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
   CHECK(hwy::SupportedTargets() == supported);
 }
 
+TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage]") {
+  // Inputs drawn directly (not through setup_column): ends on and near row borders, exact
+  // halves (ties of the rounding), long steep pieces, flat pieces around kFlatEdgeEps, at
+  // every group offset `col` inside the columns arrays, both signs.
+  std::mt19937 rng(0xc01u);
+  auto pick = [&](std::uint32_t n) {
+    return std::uniform_int_distribution<std::uint32_t>(0, n - 1)(rng);
+  };
+  auto uniform = [&](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
+  auto t_value = [&]() -> float {
+    switch (pick(5)) {
+      case 0:
+        return float(pick(9)) * 0.25f;  // row borders and quarters
+      case 1:
+        return float(uniform(0, 2));
+      case 2:
+        return float(uniform(0, 3000));  // steep piece
+      case 3:
+        return float(pick(4)) + float(uniform(-1.0 / 2048, 1.0 / 2048));  // near a border
+      default:
+        return float(pick(256)) / 256.0f;
+    }
+  };
+  auto cols = std::make_unique<CoverageColumns>();
+  const std::int64_t supported = hwy::SupportedTargets();
+  std::vector<std::int64_t> targets;
+  for (std::int64_t bits = covrast::detail::coverage_kernel_targets() & supported; bits != 0;
+       bits &= bits - 1) {
+    targets.push_back(bits & -bits);
+  }
+  constexpr int kRows = 12;
+  std::uint64_t compared = 0, differing = 0;
+  std::string first;
+  for (int round = 0; round < 3000; ++round) {
+    for (int e = 0; e < 3; ++e) {
+      for (int c = 0; c < covrast::detail::kMaxSpanColumns; ++c) {
+        float tl = t_value(),
+              tr = pick(3) == 0 ? tl + float(uniform(-1.0 / 512, 1.0 / 512)) : t_value();
+        if (tl < 0) tl = 0;
+        if (tr < 0) tr = 0;
+        const float wq = float(255 * pick(257));
+        cols->t_left[e][c] = tl;
+        cols->t_right[e][c] = tr;
+        cols->width_q[e][c] = wq;
+        cols->slope_q[e][c] =
+            std::fabs(tr - tl) >= covrast::detail::kFlatEdgeEps ? wq / (tr - tl) : 0.0f;
+        cols->base_row[e][c] = int(pick(8)) - 4;
+      }
+    }
+    const int col =
+        kColumnGroup * int(pick(std::uint32_t(covrast::detail::kMaxSpanColumns / kColumnGroup)));
+    const int row_begin = int(pick(8)) - 6;
+    const int sign = pick(2) ? 1 : -1;
+    std::vector<std::uint16_t> scalar(kRows * kColumnGroup), simd(kRows * kColumnGroup);
+    covrast::detail::coverage_rows_scalar(*cols, col, row_begin, row_begin + kRows, sign,
+                                          scalar.data(), kColumnGroup);
+    for (std::int64_t target : targets) {
+      covrast::detail::force_coverage_kernel_target(target);
+      std::fill(simd.begin(), simd.end(), kPoison);
+      covrast::detail::coverage_rows_simd(*cols, col, row_begin, row_begin + kRows, sign,
+                                          simd.data(), kColumnGroup);
+      for (int i = 0; i < kRows * kColumnGroup; ++i) {
+        ++compared;
+        if (simd[std::size_t(i)] == scalar[std::size_t(i)]) continue;
+        if (++differing == 1) {
+          const int c = col + i % kColumnGroup;
+          std::ostringstream s;
+          s << hwy::TargetName(target) << ": column " << c << " row "
+            << row_begin + i / kColumnGroup << " sign " << sign << ": simd " << simd[std::size_t(i)]
+            << ", scalar " << scalar[std::size_t(i)]
+            << "; edges (t_left, t_right, width_q, slope_q, base_row):";
+          for (int e = 0; e < 3; ++e) {
+            s << " (" << cols->t_left[e][c] << ", " << cols->t_right[e][c] << ", "
+              << cols->width_q[e][c] << ", " << cols->slope_q[e][c] << ", " << cols->base_row[e][c]
+              << ")";
+          }
+          first = s.str();
+        }
+      }
+    }
+  }
+  covrast::detail::force_coverage_kernel_target(0);
+  INFO(first);
+  CHECK(compared == 3000u * targets.size() * kRows * kColumnGroup);
+  CHECK(differing == 0);
+}
+
 // ---- Tessellations: coverages add up to exactly one pixel ------------------------------
 
 namespace {
@@ -668,6 +757,7 @@ TEST_CASE("coverage of a tessellation adds up to exactly one pixel", "[coverage]
     std::int64_t square_area2 = 0;  ///< grids: doubled area of the snapped outer square
   };
   std::vector<Case> cases;
+  std::ostringstream summary;
   auto grid = [&](const char* name, double x0, double y0, int n, double cell) {
     const std::int64_t side_x = snap(x0 + n * cell) - snap(x0);
     const std::int64_t side_y = snap(y0 + n * cell) - snap(y0);
@@ -701,5 +791,7 @@ TEST_CASE("coverage of a tessellation adds up to exactly one pixel", "[coverage]
     CHECK(res.full_pixels > 50);
     CHECK(res.wrong == 0);
     CHECK(res.over == 0);
+    summary << c.name << ": " << res.full_pixels << " full pixels, " << res.wrong << " wrong; ";
   }
+  WARN("tessellations: " << summary.str());
 }

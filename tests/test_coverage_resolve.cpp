@@ -460,23 +460,19 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
 /// 39 codes at 0), so the 8-bit measure is reported, and bounded only on average.
 constexpr double kMaskToleranceLinear = 1.0 / 32.0;
 
-// KNOWN DEFECT (issue 3, open): the flat-colour checks here pass, but the silhouette of the
-// sphere on black differs from the brute-force reference by up to 29/255 (linear 0.14,
-// tolerance 1/32) in a few outline pixels, where front- and back-facing fragments meet
-// and the per-sample path decides. Kept running with [!mayfail] so it stays visible.
-TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage][!mayfail]") {
+/// A UV sphere (24 x 48) of radius 3 at (0.1, 0.05, 0), 128 x 96 pixels.
+Scene sphere_scene(glm::vec3 color, glm::vec3 background) {
+  Scene s = make_scene(128, 96, background);
+  add_instance(s, uv_sphere(24, 48), color);
+  s.meshes.back().model = glm::dmat4(glm::dvec4(3, 0, 0, 0), glm::dvec4(0, 3, 0, 0),
+                                     glm::dvec4(0, 0, 3, 0), glm::dvec4(0.1, 0.05, 0, 1));
+  return s;
+}
+
+TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]") {
   const int codes[3] = {180, 95, 40};
   const glm::vec3 color = from_codes(codes[0], codes[1], codes[2]);
-  auto sphere = uv_sphere(24, 48);
-  // Sphere of radius 1 at distance 10: silhouette radius tan(asin(0.1)) / tan(22.5 deg) * 48
-  // = 11.64 px around the image centre (64, 48).
-  auto make = [&](glm::vec3 background) {
-    Scene s = make_scene(128, 96, background);
-    add_instance(s, sphere, color);
-    s.meshes.back().model = glm::dmat4(glm::dvec4(3, 0, 0, 0), glm::dvec4(0, 3, 0, 0),
-                                       glm::dvec4(0, 0, 3, 0), glm::dvec4(0.1, 0.05, 0, 1));
-    return s;
-  };
+  auto make = [&](glm::vec3 background) { return sphere_scene(color, background); };
   // Scaled by 3, moved by (0.1, 0.05): radius tan(asin(0.3)) / tan(22.5 deg) * 48 = 36.4 px.
   const double centre_x = 64 + 0.1 / (kEyeZ * std::tan(kFovyDeg * kPi / 360.0)) * 48;
   const double centre_y = 48 - 0.05 / (kEyeZ * std::tan(kFovyDeg * kPi / 360.0)) * 48;
@@ -536,15 +532,105 @@ TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]
     // The check above can fail: the plain seed's blending leaks the background at seams.
     CHECK(blend_seams > 100);
   }
-  SECTION("on another colour: the outline matches the reference") {
-    // Front and back faces meet at the outline: two layers of one surface, resolved on
-    // the sub-pixel masks there.
-    const Scene s = make(from_codes(0, 0, 0));
-    const std::vector<TriangleSetup> tris = screen_triangles(s);
-    const Comparison c = compare(render(s, ModeKind::Coverage).color, reference_render(s, tris));
-    WARN("sphere on black against the reference: " << describe(c));
+}
+
+// KNOWN DEFECT (open): near the poles of the sphere more than kMaxFragmentsPerPixel (16)
+// triangles, front and back faces, touch one outline pixel. The overflow merges a new
+// fragment into the oldest one of the same surface and facing: its coverage is added but its
+// sub-pixel mask is lost, so on the per-sample path the merged area hides nothing and the
+// back faces win those samples. A few outline pixels come out up to 0.14 linear (29/255)
+// too bright. With the back faces removed (no overflow) the same outline is within 1/255.
+// Kept running with [!mayfail] so the failure stays visible.
+TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage][!mayfail]") {
+  // Front and back faces meet at the outline: two layers of one surface, resolved on the
+  // sub-pixel masks there.
+  const Scene s = sphere_scene(from_codes(180, 95, 40), from_codes(0, 0, 0));
+  const std::vector<TriangleSetup> tris = screen_triangles(s);
+  const auto result = render(s, ModeKind::Coverage);
+  const ReferenceImage ref = reference_render(s, tris);
+  const Comparison c = compare(result.color, ref);
+  std::ostringstream over;
+  for (int y = 0; y < s.height; ++y) {
+    for (int x = 0; x < s.width; ++x) {
+      const double got = covrast::srgb_to_linear(result.color.pixel(x, y)[0] / 255.0f);
+      const double want = ref.linear[std::size_t(y) * std::size_t(s.width) + std::size_t(x)].r;
+      if (std::fabs(got - want) > kMaskToleranceLinear) {
+        over << " (" << x << ", " << y << "): red " << got << " vs " << want << ";";
+      }
+    }
+  }
+  WARN("sphere on black against the reference: " << describe(c) << "; fragment overflows "
+                                                 << result.stats.fragment_overflows
+                                                 << "; pixels beyond the tolerance:" << over.str());
+  CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+  CHECK(c.mean_diff8 < 0.05);
+}
+
+TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[coverage]") {
+  // The control of the case above: the same sphere with the faces turned away from the eye
+  // removed (fewer than 16 fragments per pixel everywhere).
+  Scene s = sphere_scene(from_codes(180, 95, 40), from_codes(0, 0, 0));
+  auto mesh = std::make_shared<MeshData>(*s.meshes[0].mesh);
+  std::vector<std::uint32_t> front;
+  const glm::dmat4 model = s.meshes[0].model;
+  for (std::size_t k = 0; k < mesh->indices.size(); k += 3) {
+    glm::dvec3 v[3];
+    for (int j = 0; j < 3; ++j) {
+      v[j] = glm::dvec3(model * glm::dvec4(glm::dvec3(mesh->positions[mesh->indices[k + j]]), 1));
+    }
+    if (glm::dot(glm::cross(v[1] - v[0], v[2] - v[0]), s.camera.eye - v[0]) > 0) {
+      front.insert(front.end(), mesh->indices.begin() + std::ptrdiff_t(k),
+                   mesh->indices.begin() + std::ptrdiff_t(k + 3));
+    }
+  }
+  mesh->indices = front;
+  s.meshes[0].mesh = mesh;
+  const auto result = render(s, ModeKind::Coverage);
+  const Comparison c = compare(result.color, reference_render(s, screen_triangles(s)));
+  WARN("sphere, front faces only (" << front.size() / 3
+                                    << " triangles), against the reference: " << describe(c)
+                                    << "; fragment overflows " << result.stats.fragment_overflows);
+  CHECK(front.size() / 3 > 500);
+  CHECK(result.stats.fragment_overflows == 0);
+  CHECK(c.max_diff8 <= 1);
+  CHECK(c.mean_diff8 < 0.01);
+}
+
+// KNOWN DEFECT (open): see "a sphere's outline matches the reference". A fan of 24 slivers
+// of one mesh meets at (20.25, 20.5), covering x < 20.25 of pixel (20, 20) (a quarter); a
+// triangle of another mesh behind covers x < 20.6 of that pixel. All 25 touch the pixel. The
+// expected pixel: red 0.25, blue 0.35, black 0.4 (linear). Measured: fan drawn first, the
+// list is full when the blue triangle comes and, being farther, it is dropped (blue 0);
+// blue drawn first, the merged slivers lose their masks and blue wins their samples
+// (blue 0.47).
+TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places",
+          "[coverage][!mayfail]") {
+  for (bool back_first : {false, true}) {
+    Scene s = make_scene(40, 40, glm::vec3(0));
+    std::vector<ScreenVertex> fan;
+    constexpr int kSpokes = 24;
+    for (int k = 0; k < kSpokes; ++k) {
+      const double a0 = kPi / 2 + kPi * k / kSpokes, a1 = kPi / 2 + kPi * (k + 1) / kSpokes;
+      fan.push_back({20.25, 20.5, 0.5});
+      fan.push_back({20.25 + 10 * std::cos(a0), 20.5 - 10 * std::sin(a0), 0.5});
+      fan.push_back({20.25 + 10 * std::cos(a1), 20.5 - 10 * std::sin(a1), 0.5});
+    }
+    auto back = screen_mesh(s, {{20.6, 4.0, 0.0}, {20.6, 37.0, 0.0}, {2.0, 20.5, 0.0}});
+    if (back_first) add_instance(s, back, glm::vec3(0, 0, 1));
+    add_instance(s, screen_mesh(s, fan), glm::vec3(1, 0, 0));
+    if (!back_first) add_instance(s, back, glm::vec3(0, 0, 1));
+    const auto result = render(s, ModeKind::Coverage);
+    const ReferenceImage ref = reference_render(s, screen_triangles(s));
+    const Comparison c = compare(result.color, ref);
+    const std::uint8_t* p = result.color.pixel(20, 20);
+    const glm::dvec3 r = ref.linear[20 * 40 + 20];
+    WARN("fan of 24 over a triangle behind, "
+         << (back_first ? "back" : "fan") << " drawn first: " << describe(c)
+         << "; pixel (20, 20) = (" << int(p[0]) << ", " << int(p[1]) << ", " << int(p[2])
+         << "), reference (" << encode8(r.r) << ", " << encode8(r.g) << ", " << encode8(r.b)
+         << "); fragment overflows " << result.stats.fragment_overflows);
+    CHECK(result.stats.fragment_overflows > 0);
     CHECK(c.max_diff_linear <= kMaskToleranceLinear);
-    CHECK(c.mean_diff8 < 0.05);
   }
 }
 

@@ -27,6 +27,7 @@ ReferenceRasterizer::ReferenceRasterizer(int tile_px) : tile_px_(tile_px) {
     oy_.push_back(double(pattern.y[std::size_t(s)]) / kReferenceUnit);
   }
   depth_.resize(ox_.size());
+  inside_.resize(ox_.size());
   winner_.resize(ox_.size());
   linear_.resize(std::size_t(tile_px) * tile_px);
   linear_float_.resize(linear_.size());
@@ -54,7 +55,9 @@ void ReferenceRasterizer::end_tile(const FrameTarget& target) {
 
 std::size_t ReferenceRasterizer::scratch_bytes() const {
   return (ox_.capacity() + oy_.capacity() + depth_.capacity()) * sizeof(double) +
-         winner_.capacity() * sizeof(std::uint32_t) + pending_.capacity() * sizeof(Pending) +
+         (winner_.capacity() + flat_count_.capacity() + touched_.capacity()) *
+             sizeof(std::uint32_t) +
+         inside_.capacity() + pending_.capacity() * sizeof(Pending) +
          (row_begin_.capacity() + row_items_.capacity() + row_cursor_.capacity()) *
              sizeof(std::uint32_t) +
          linear_.capacity() * sizeof(glm::dvec3) + linear_float_.capacity() * sizeof(glm::vec3) +
@@ -70,6 +73,7 @@ void ReferenceRasterizer::resolve_tile(const FrameTarget&) {
   }
   for (int r = 0; r < rows; ++r) row_begin_[std::size_t(r) + 1] += row_begin_[std::size_t(r)];
   row_items_.resize(row_begin_[std::size_t(rows)]);
+  flat_count_.assign(pending_.size(), 0);
   row_cursor_.assign(row_begin_.begin(), row_begin_.end() - 1);
   for (std::uint32_t i = 0; i < pending_.size(); ++i) {
     const Pending& p = pending_[i];
@@ -81,24 +85,48 @@ void ReferenceRasterizer::resolve_tile(const FrameTarget&) {
   for (int y = rect_.y0; y < rect_.y1; ++y) {
     const std::size_t row = std::size_t(y - rect_.y0);
     for (int x = rect_.x0; x < rect_.x1; ++x) {
+      const std::size_t i = row * std::size_t(tile_px_) + std::size_t(x - rect_.x0);
+      bool touched = false;
+      for (std::uint32_t k = row_begin_[row]; k < row_begin_[row + 1] && !touched; ++k) {
+        const Pending& p = pending_[row_items_[k]];
+        touched = x >= p.rect.x0 && x < p.rect.x1;
+      }
+      if (!touched) {
+        linear_[i] = background_;
+        pixel_depth_[i] = std::numeric_limits<float>::infinity();
+        continue;
+      }
       std::fill(depth_.begin(), depth_.end(), std::numeric_limits<double>::infinity());
       std::fill(winner_.begin(), winner_.end(), kNoTriangle);
       for (std::uint32_t k = row_begin_[row]; k < row_begin_[row + 1]; ++k) {
         const Pending& p = pending_[row_items_[k]];
         if (x >= p.rect.x0 && x < p.rect.x1) sample_pixel(*p.triangle, row_items_[k], x, y);
       }
-      // Box filter in double; each sample shaded at its own position.
+      // Box filter in double; each sample shaded at its own position. A flat triangle
+      // shades the same everywhere, so its samples are counted and weighted once.
       glm::dvec3 sum(0.0);
       double nearest = std::numeric_limits<double>::infinity();
+      std::uint32_t background_count = 0;
+      touched_.clear();
       for (std::size_t s = 0; s < count; ++s) {
-        if (winner_[s] == kNoTriangle) {
-          sum += background_;
+        const std::uint32_t w = winner_[s];
+        if (w == kNoTriangle) {
+          ++background_count;
           continue;
         }
-        sum += glm::dvec3(shade(*pending_[winner_[s]].triangle, x + ox_[s], y + oy_[s], false));
         nearest = std::min(nearest, depth_[s]);
+        const TriangleSetup& t = *pending_[w].triangle;
+        if (t.flat_color) {
+          if (flat_count_[w]++ == 0) touched_.push_back(w);
+          continue;
+        }
+        sum += glm::dvec3(shade(t, x + ox_[s], y + oy_[s], false));
       }
-      const std::size_t i = row * std::size_t(tile_px_) + std::size_t(x - rect_.x0);
+      sum += background_ * double(background_count);
+      for (std::uint32_t w : touched_) {
+        sum += glm::dvec3(pending_[w].triangle->color[0]) * double(flat_count_[w]);
+        flat_count_[w] = 0;
+      }
       linear_[i] = sum / double(count);
       pixel_depth_[i] = float(nearest);
     }
@@ -130,19 +158,22 @@ void ReferenceRasterizer::sample_pixel(const TriangleSetup& t, std::uint32_t ind
   }
   const double z0 = t.depth_at(x, y);
   const std::size_t count = ox_.size();
+  // Branch-free passes (the compiler vectorises them): the edges first, then depth.
+  std::fill(inside_.begin(), inside_.end(), std::uint8_t(1));
+  for (int k = 0; k < partial_count; ++k) {
+    const int e = partial[k];
+    const double a = e0[e], ex = dx[e], ey = dy[e];
+    if (top_left[e]) {
+      for (std::size_t s = 0; s < count; ++s) inside_[s] &= a + (ex * oy_[s] - ey * ox_[s]) >= 0.0;
+    } else {
+      for (std::size_t s = 0; s < count; ++s) inside_[s] &= a + (ex * oy_[s] - ey * ox_[s]) > 0.0;
+    }
+  }
   for (std::size_t s = 0; s < count; ++s) {
-    bool inside = true;
-    for (int k = 0; k < partial_count; ++k) {
-      const int e = partial[k];
-      const double value = e0[e] + (dx[e] * oy_[s] - dy[e] * ox_[s]);
-      inside &= top_left[e] ? value >= 0.0 : value > 0.0;
-    }
-    if (!inside) continue;
     const double z = z0 + (t.dzdx * ox_[s] + t.dzdy * oy_[s]);
-    if (z < depth_[s]) {
-      depth_[s] = z;
-      winner_[s] = index;
-    }
+    const bool wins = inside_[s] != 0 && z < depth_[s];
+    depth_[s] = wins ? z : depth_[s];
+    winner_[s] = wins ? index : winner_[s];
   }
 }
 

@@ -48,8 +48,11 @@ class ReferenceRasterizer final : public TileRasterizer {
   int tile_px_;
   std::vector<double> ox_;  ///< sample offsets from the pixel corner [pixels]
   std::vector<double> oy_;
-  std::vector<double> depth_;          ///< per sample of the current pixel
-  std::vector<std::uint32_t> winner_;  ///< index into pending_, or kNoTriangle
+  std::vector<double> depth_;              ///< per sample of the current pixel
+  std::vector<std::uint32_t> winner_;      ///< index into pending_, or kNoTriangle
+  std::vector<std::uint8_t> inside_;       ///< per sample: inside the triangle being drawn
+  std::vector<std::uint32_t> flat_count_;  ///< resolve: samples won per flat triangle
+  std::vector<std::uint32_t> touched_;     ///< resolve: flat triangles in order of first win
   std::vector<Pending> pending_;
   std::vector<std::uint32_t> row_begin_;
   std::vector<std::uint32_t> row_items_;

@@ -113,6 +113,45 @@ bool SampleGroup(const GroupPattern& pattern, const GroupTriangle& tri, const st
   return SampleGroupImpl<false>(pattern, tri, f, z_base, rgb, out, written);
 }
 
+void RasterTriangle(const GroupPattern& pattern, const RasterJob& job, GroupTriangle& tri) {
+  const std::size_t lanes = std::size_t(pattern.lanes);
+  bool set_up = false;
+  std::int64_t f_row[3] = {job.f[0], job.f[1], job.f[2]};
+  for (int row = 0; row < job.rows; ++row) {
+    const int y = job.y0 + row;
+    const double z_y = job.dzdy * (double(y) - job.vy);
+    std::int64_t f[3] = {f_row[0], f_row[1], f_row[2]};
+    std::size_t lane = std::size_t(row) * job.row_lanes;
+    for (int g = 0; g < job.groups; ++g, lane += lanes) {
+      bool none = false, all_inside = true;
+      std::int32_t f32[3];
+      for (int e = 0; e < 3; ++e) {
+        none |= f[e] + job.c_max[e] < 0;
+        all_inside &= f[e] + job.c_min[e] >= 0;
+        f32[e] = std::int32_t(f[e] < kEdgeClamp ? f[e] : kEdgeClamp);
+        f[e] += job.step_x[e];
+      }
+      if (none) continue;
+      if (!set_up) {
+        SetupGroup(pattern, job.dx, job.dy, true, job.dzdx_f, job.dzdy_f, tri);
+        set_up = true;
+      }
+      const int gx = job.gx0 + g * pattern.group_px;
+      const float z_base = float(job.z0 + job.dzdx * (double(gx) - job.vx) + z_y);
+      const GroupSamples out{job.first.depth + lane, job.first.r + lane, job.first.g + lane,
+                             job.first.b + lane};
+      std::uint64_t written[kMaxGroupLanes / 64] = {0, 0, 0, 0};
+      std::uint64_t* written_ptr = job.rgb != nullptr ? nullptr : written;
+      const bool any =
+          all_inside
+              ? SampleGroupImpl<false>(pattern, tri, nullptr, z_base, job.rgb, out, written_ptr)
+              : SampleGroupImpl<true>(pattern, tri, f32, z_base, job.rgb, out, written_ptr);
+      if (any && job.rgb == nullptr) job.shade_fn(job.shade_context, gx, y, written, out);
+    }
+    for (int e = 0; e < 3; ++e) f_row[e] += job.step_y[e];
+  }
+}
+
 void ResolvePixels(const GroupPattern& pattern, int pixels, const GroupSamples& in,
                    const std::uint32_t background[3], std::uint32_t* sums, float* min_depth) {
   const int s_count = pattern.samples;
@@ -150,7 +189,17 @@ void ResolvePixels(const GroupPattern& pattern, int pixels, const GroupSamples& 
     const std::size_t base = std::size_t(p) * stride;
     auto r = hn::Zero(du), g = hn::Zero(du), b = hn::Zero(du);
     auto z = vinf;
-    for (std::size_t i = 0; i < std::size_t(s_count); i += n) {
+    std::size_t i = 0;
+    for (; i + n <= std::size_t(s_count); i += n) {
+      const auto d = hn::LoadU(df, in.depth + base + i);
+      const auto written = hn::RebindMask(du, hn::Lt(d, vinf));
+      r = hn::Add(r, hn::IfThenElse(written, hn::LoadU(du, in.r + base + i), bg_r));
+      g = hn::Add(g, hn::IfThenElse(written, hn::LoadU(du, in.g + base + i), bg_g));
+      b = hn::Add(b, hn::IfThenElse(written, hn::LoadU(du, in.b + base + i), bg_b));
+      z = hn::Min(z, d);
+    }
+    if (i < std::size_t(s_count)) {
+      // The last chunk of a padded pixel: only its first S - i lanes are samples.
       const auto real = hn::FirstN(du, std::size_t(s_count) - i);
       const auto d = hn::LoadU(df, in.depth + base + i);
       const auto written = hn::RebindMask(du, hn::Lt(d, vinf));
@@ -184,6 +233,7 @@ namespace covrast::detail {
 
 HWY_EXPORT(SetupGroup);
 HWY_EXPORT(SampleGroup);
+HWY_EXPORT(RasterTriangle);
 HWY_EXPORT(ResolvePixels);
 HWY_EXPORT(ClearDepth);
 
@@ -196,7 +246,8 @@ SampleKernels sample_kernels_simd() {
   const std::size_t index = chosen.GetIndex();
   return SampleKernels{
       HWY_DISPATCH_TABLE(SetupGroup)[index], HWY_DISPATCH_TABLE(SampleGroup)[index],
-      HWY_DISPATCH_TABLE(ResolvePixels)[index], HWY_DISPATCH_TABLE(ClearDepth)[index]};
+      HWY_DISPATCH_TABLE(RasterTriangle)[index], HWY_DISPATCH_TABLE(ResolvePixels)[index],
+      HWY_DISPATCH_TABLE(ClearDepth)[index]};
 }
 
 std::int64_t sample_kernel_targets() { return HWY_TARGETS; }

@@ -15,7 +15,7 @@
 // F + max c < 0 (no lane inside) and skips an edge's test when F + min c >= 0 (every lane
 // inside). A tested edge therefore has -M <= F < M, so when M < 2^29 = kEdgeClamp both F
 // and F + c_l (|.| < 2^30) fit int32 exactly. Triangles with a longer edge take a scalar
-// int64 path for their partly covered groups (rare: only edges longer than ~2^21/G px).
+// int64 path for their partly covered groups (rare: |dx| + |dy| >= 8192 / G pixels).
 //
 // Depth is float: z_l = float(depth at the group origin) + dz_l, dz_l = float(dzdx) ox_l +
 // float(dzdy) oy_l [pixels], evaluated as separate IEEE multiplies and adds (no FMA), so
@@ -88,6 +88,42 @@ using SampleGroupFn = bool (*)(const GroupPattern& pattern, const GroupTriangle&
                                const std::int32_t* f, float z_base, const std::uint32_t* rgb,
                                const GroupSamples& out, std::uint64_t* written);
 
+/// Called for every group where a triangle without a flat colour won lanes (bit l of
+/// `written` set), so that the rasterizer shades them (shading.hpp).
+using ShadeWrittenFn = void (*)(void* context, int gx, int y, const std::uint64_t* written,
+                                const GroupSamples& group);
+
+/// One triangle over a rectangle of groups: the whole per-triangle loop in one call, for
+/// triangles whose edges fit the int32 bound. Per group, with int64 F: skip it when some
+/// F + c_max < 0; test no edge when every F + c_min >= 0; else test the lanes with
+/// f = min(F, kEdgeClamp) as in SampleGroupFn. The lane constants are set up (into
+/// `scratch`) at the first group that is not skipped.
+struct RasterJob {
+  int gx0 = 0;     ///< x of the first group [px], a multiple of G
+  int y0 = 0;      ///< first row [px]
+  int groups = 0;  ///< groups per row
+  int rows = 0;
+  std::int64_t f[3];       ///< F = E + bias at (gx0, y0) [fx8^2]
+  std::int64_t step_x[3];  ///< change of F from one group to the next
+  std::int64_t step_y[3];  ///< change of F from one row to the next
+  std::int64_t c_min[3];   ///< bounds of c over the group's lanes
+  std::int64_t c_max[3];
+  std::int32_t dx[3];  ///< edge vectors [fx8]
+  std::int32_t dy[3];
+  float dzdx_f;  ///< depth slopes for dz
+  float dzdy_f;
+  /// Depth plane as in TriangleSetup::depth_at: z(x, y) = z0 + dzdx (x - vx) + dzdy (y - vy);
+  /// z_base = float(z(gx, y)) at each group origin.
+  double z0, dzdx, dzdy, vx, vy;
+  const std::uint32_t* rgb;  ///< flat colour, or null: then shade_fn is called
+  ShadeWrittenFn shade_fn;
+  void* shade_context;
+  GroupSamples first;     ///< lanes of group (gx0, y0)
+  std::size_t row_lanes;  ///< lanes from one buffer row to the next
+};
+using RasterTriangleFn = void (*)(const GroupPattern& pattern, const RasterJob& job,
+                                  GroupTriangle& scratch);
+
 /// Box-filter sums of `pixels` consecutive pixels: sums[3 p + k] = sum over the S real
 /// samples of channel k, where a sample whose depth is +infinity (never written since the
 /// band was cleared) counts as `background`; and, when `min_depth` is not null, the
@@ -103,6 +139,7 @@ using ClearDepthFn = void (*)(float* depth, std::size_t count);
 struct SampleKernels {
   SetupGroupFn setup;
   SampleGroupFn sample;
+  RasterTriangleFn raster;
   ResolvePixelsFn resolve;
   ClearDepthFn clear;
 };

@@ -193,8 +193,45 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
     rgb[2] = quantize_color(t.color[0].b);
     flat_rgb = rgb;
   }
-  bool set_up = false;
   const std::size_t stride = std::size_t(gp.stride);
+  if (fits) {
+    RasterJob job;
+    job.gx0 = gx0;
+    job.y0 = r.y0;
+    job.groups = (r.x1 - gx0 + group_px - 1) / group_px;
+    job.rows = r.y1 - r.y0;
+    for (int e = 0; e < 3; ++e) {
+      job.f[e] = f_row[e];
+      job.step_x[e] = step_x[e];
+      job.step_y[e] = step_y[e];
+      job.c_min[e] = c_min[e];
+      job.c_max[e] = c_max[e];
+      job.dx[e] = dx32[e];
+      job.dy[e] = dy32[e];
+    }
+    job.dzdx_f = float(t.dzdx);
+    job.dzdy_f = float(t.dzdy);
+    job.z0 = t.z0;
+    job.dzdx = t.dzdx;
+    job.dzdy = t.dzdy;
+    job.vx = t.x_fx8[0] * (1.0 / kSubpixelOne);
+    job.vy = t.y_fx8[0] * (1.0 / kSubpixelOne);
+    job.rgb = flat_rgb;
+    ShadeContext context{this, &t};
+    job.shade_fn = &SampleRasterizer::shade_trampoline;
+    job.shade_context = &context;
+    const std::size_t lane =
+        (std::size_t(r.y0 - band_y0_) * std::size_t(buffer_px_) + std::size_t(gx0 - buffer_x0_)) *
+        stride;
+    job.first =
+        GroupSamples{depth_.get() + lane, r_.get() + lane, g_.get() + lane, b_.get() + lane};
+    job.row_lanes = row_lanes_;
+    kernels_.raster(gp, job, *tri_);
+    return;
+  }
+  // An edge too long for int32 lanes: classify here, and test partly covered groups with
+  // int64 arithmetic (sample_wide).
+  bool set_up = false;
   for (int y = r.y0; y < r.y1; ++y) {
     std::int64_t f[3] = {f_row[0], f_row[1], f_row[2]};
     std::size_t lane =
@@ -210,7 +247,7 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
       for (int e = 0; e < 3; ++e) f[e] += step_x[e];
       if (none) continue;
       if (!set_up) {
-        kernels_.setup(gp, dx32, dy32, fits, float(t.dzdx), float(t.dzdy), *tri_);
+        kernels_.setup(gp, dx32, dy32, false, float(t.dzdx), float(t.dzdy), *tri_);
         set_up = true;
       }
       const float z_base = float(t.depth_at(gx, y));
@@ -221,13 +258,6 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
       bool any;
       if (all_inside) {
         any = kernels_.sample(gp, *tri_, nullptr, z_base, flat_rgb, out, written_ptr);
-      } else if (fits) {
-        // Not rejected: F >= -max c > -kEdgeClamp; an edge with every lane inside may
-        // have a larger F, which clamping keeps inside (F + c >= 2^29 - |c| > 0).
-        const std::int32_t f32[3] = {std::int32_t(std::min<std::int64_t>(f_here[0], kEdgeClamp)),
-                                     std::int32_t(std::min<std::int64_t>(f_here[1], kEdgeClamp)),
-                                     std::int32_t(std::min<std::int64_t>(f_here[2], kEdgeClamp))};
-        any = kernels_.sample(gp, *tri_, f32, z_base, flat_rgb, out, written_ptr);
       } else {
         any = false;
         sample_wide(t, f_here, z_base, flat_rgb, out, written);
@@ -263,6 +293,12 @@ void SampleRasterizer::sample_wide(const TriangleSetup& t, const std::int64_t f[
     }
     written[l / 64] |= std::uint64_t(1) << (l % 64);
   }
+}
+
+void SampleRasterizer::shade_trampoline(void* context, int gx, int y, const std::uint64_t* written,
+                                        const GroupSamples& group) {
+  const ShadeContext& c = *static_cast<const ShadeContext*>(context);
+  c.self->shade_written(*c.triangle, gx, y, written, group);
 }
 
 void SampleRasterizer::shade_written(const TriangleSetup& t, int gx, int y,

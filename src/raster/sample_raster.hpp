@@ -3,7 +3,7 @@
 //
 // Per tile it keeps, for every sample, a float depth and a fixed-point linear colour
 // (sample_kernel.hpp), pixel-major. The tile is rasterized in horizontal bands whose
-// sample buffers fit `band_budget_bytes` (sized to stay in the core's L2 cache): when the
+// sample buffers fit `band_budget_bytes` (2 MiB by default): when the
 // whole tile fits, triangles are rasterized as they arrive; otherwise draw() only records
 // them and end_tile() replays each band's triangles, in draw order, band after band.
 // Resolve: the box filter, i.e. the mean linear colour over the pixel's samples, then
@@ -27,8 +27,10 @@ enum class ShadingRate {
   PerPixel,   ///< msaa: shade() once per pixel and triangle, at the centre, clamped inside
 };
 
-/// Default band budget: four sample buffers of at most 512 KiB together.
-inline constexpr std::size_t kDefaultBandBudgetBytes = std::size_t(512) << 10;
+/// Default band budget for the four sample buffers together: a whole 64-pixel tile in one
+/// band up to 16 samples per pixel, 8 bands of 8 rows at 256. Measured on the 500k-triangle
+/// scene, 2 MiB bands beat L2-sized (512 KiB) ones: fewer re-walks of the triangle list.
+inline constexpr std::size_t kDefaultBandBudgetBytes = std::size_t(2048) << 10;
 
 class SampleRasterizer final : public TileRasterizer {
  public:
@@ -56,6 +58,12 @@ class SampleRasterizer final : public TileRasterizer {
     const TriangleSetup* triangle;
     PixelRect rect;
   };
+  struct ShadeContext {
+    SampleRasterizer* self;
+    const TriangleSetup* triangle;
+  };
+  static void shade_trampoline(void* context, int gx, int y, const std::uint64_t* written,
+                               const GroupSamples& group);
   void start_band(int y0, int y1);
   void rasterize(const TriangleSetup& t, const PixelRect& r);
   void sample_wide(const TriangleSetup& t, const std::int64_t f[3], float z_base,
