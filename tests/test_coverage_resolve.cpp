@@ -534,14 +534,10 @@ TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]
   }
 }
 
-// KNOWN DEFECT (open): near the poles of the sphere more than kMaxFragmentsPerPixel (16)
-// triangles, front and back faces, touch one outline pixel. The overflow merges a new
-// fragment into the oldest one of the same surface and facing: its coverage is added but its
-// sub-pixel mask is lost, so on the per-sample path the merged area hides nothing and the
-// back faces win those samples. A few outline pixels come out up to 0.14 linear (29/255)
-// too bright. With the back faces removed (no overflow) the same outline is within 1/255.
-// Kept running with [!mayfail] so the failure stays visible.
-TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage][!mayfail]") {
+// Near the poles of the sphere more than kMaxFragmentsPerPixel (16) triangles, front and
+// back faces, touch one outline pixel: this exercises the overflow merge (masks united) on
+// the per-sample path. (It once failed by 29/255 when merges dropped the masks.)
+TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage]") {
   // Front and back faces meet at the outline: two layers of one surface, resolved on the
   // sub-pixel masks there.
   const Scene s = sphere_scene(from_codes(180, 95, 40), from_codes(0, 0, 0));
@@ -596,15 +592,11 @@ TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[c
   CHECK(c.mean_diff8 < 0.01);
 }
 
-// KNOWN DEFECT (open): see "a sphere's outline matches the reference". A fan of 24 slivers
-// of one mesh meets at (20.25, 20.5), covering x < 20.25 of pixel (20, 20) (a quarter); a
-// triangle of another mesh behind covers x < 20.6 of that pixel. All 25 touch the pixel. The
-// expected pixel: red 0.25, blue 0.35, black 0.4 (linear). Measured: fan drawn first, the
-// list is full when the blue triangle comes and, being farther, it is dropped (blue 0);
-// blue drawn first, the merged slivers lose their masks and blue wins their samples
-// (blue 0.47).
-TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places",
-          "[coverage][!mayfail]") {
+// A fan of 24 slivers of one mesh meets at (20.25, 20.5), covering x < 20.25 of pixel
+// (20, 20) (a quarter); a triangle of another mesh behind covers x < 20.6 of that pixel. All
+// 25 touch the pixel. Expected (linear): red 0.25, blue 0.35, black 0.4. Overflow must
+// neither drop the farther triangle nor lose the merged slivers' sample masks.
+TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places", "[coverage]") {
   for (bool back_first : {false, true}) {
     Scene s = make_scene(40, 40, glm::vec3(0));
     std::vector<ScreenVertex> fan;
@@ -753,13 +745,9 @@ TEST_CASE("coverage mode: a partial occluder hides only where it covers", "[cove
   }
 }
 
-// KNOWN DEFECT (issue 3, open): the resolve groups same-surface fragments whose depth
-// ranges over the pixel meet into one layer and adds their areas. A steep fold of one mesh
-// has overlapping depth ranges, so its front and back parts are merged and the back shows
-// through. Kept running with [!mayfail] so the failure stays visible in every test log
-// until the grouping test is made exact (e.g. by checking the sample masks for overlap).
-TEST_CASE("coverage mode: a steep fold of one mesh hides the part behind it",
-          "[coverage][!mayfail]") {
+// Fragments of one surface are one layer (areas add) only when connected through shared
+// vertices; a steep fold of one mesh over another part of it must still hide that part.
+TEST_CASE("coverage mode: a steep fold of one mesh hides the part behind it", "[coverage]") {
   // One mesh, one facing. F covers x < 30.5 of column 30 and is steep in depth (window
   // depth +0.04 per pixel to the right); B covers y < 20.5 of row 20 at a constant depth
   // that F's plane reaches only right of x = 30.5, outside F. In pixel (30, 20) F is in

@@ -56,6 +56,18 @@ bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
   return a.surface == b.surface && a.front_facing == b.front_facing;
 }
 
+/// Adjacent pieces of a conforming tessellation share a vertex (an edge, or a fan's centre).
+/// A fold of one mesh over itself shares none with what it covers, or, folded over a shared
+/// edge, has the opposite facing.
+bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      if (a.x_fx8[i] == b.x_fx8[j] && a.y_fx8[i] == b.y_fx8[j]) return true;
+    }
+  }
+  return false;
+}
+
 /// Samples of an 8x8 grid at ((i + 0.5) / 8, (j + 0.5) / 8) inside pixel (x, y), bit
 /// j * 8 + i, that the triangle owns under the top-left rule.
 std::uint64_t sample_mask(const TriangleSetup& t, int x, int y) {
@@ -127,19 +139,23 @@ void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t covera
   add_fragment(pixel, x, y, t, coverage);
 }
 
-void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                               std::uint32_t coverage) {
-  if (count_[pixel] >= kMaxFragmentsPerPixel) {
-    ++overflows_;
-    // 1. Drop fragments that the opaque surface now hides everywhere.
-    const TriangleSetup* opaque = opaque_[pixel];
+void ABufferTile::merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, int x,
+                             int y) {
+  if (!f.merged) f.mask = sample_mask(*f.triangle, x, y);
+  f.mask |= mask;
+  f.merged = true;
+  f.coverage = std::min<std::uint32_t>(f.coverage + coverage, kCoverageOne);
+}
+
+bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                  std::uint32_t coverage) {
+  ++overflows_;
+  // 1. Drop fragments that the opaque surface now hides everywhere.
+  if (const TriangleSetup* opaque = opaque_[pixel]; opaque != nullptr) {
     std::uint32_t kept = kEnd, last = kEnd;
     int n = 0;
     for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-      if (opaque != nullptr &&
-          order_of(*pool_[f].triangle, *opaque, x, y) == DepthOrder::Behind) {
-        continue;
-      }
+      if (order_of(*pool_[f].triangle, *opaque, x, y) == DepthOrder::Behind) continue;
       if (last == kEnd) {
         kept = f;
       } else {
@@ -152,32 +168,57 @@ void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSe
     head_[pixel] = kept;
     tail_[pixel] = last;
     count_[pixel] = std::uint8_t(n);
-    if (n >= kMaxFragmentsPerPixel) {
-      // 2. Merge into the oldest fragment of the same surface and facing.
-      for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-        const TriangleSetup& o = *pool_[f].triangle;
-        if (o.surface == t->surface && o.front_facing == t->front_facing) {
-          pool_[f].coverage = std::min<std::uint32_t>(pool_[f].coverage + coverage, kCoverageOne);
-          return;
-        }
-      }
-      // 3. Keep the nearest: replace the farthest fragment if the new one is nearer.
-      const double cx = x + 0.5, cy = y + 0.5;
-      std::uint32_t farthest = head_[pixel];
-      for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-        if (pool_[f].triangle->depth_at(cx, cy) > pool_[farthest].triangle->depth_at(cx, cy)) {
-          farthest = f;
-        }
-      }
-      if (t->depth_at(cx, cy) < pool_[farthest].triangle->depth_at(cx, cy)) {
-        pool_[farthest].triangle = t;
-        pool_[farthest].coverage = coverage;
-      }
-      return;
+    if (n < kMaxFragmentsPerPixel) return false;
+  }
+  // 2. Merge the new fragment into an adjacent fragment of its surface, else any of it.
+  std::uint32_t same = kEnd;
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    const TriangleSetup& o = *pool_[f].triangle;
+    if (!same_surface(o, *t)) continue;
+    if (share_vertex(o, *t)) {
+      same = f;
+      break;
+    }
+    if (same == kEnd) same = f;
+  }
+  if (same != kEnd) {
+    merge_into(pool_[same], coverage, sample_mask(*t, x, y), x, y);
+    return true;
+  }
+  // 3. Merge two fragments of one surface already in the list, freeing a slot.
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    std::uint32_t prev = f;
+    for (std::uint32_t g = pool_[f].next; g != kEnd; prev = g, g = pool_[g].next) {
+      if (!same_surface(*pool_[f].triangle, *pool_[g].triangle)) continue;
+      Fragment& victim = pool_[g];
+      merge_into(pool_[f], victim.coverage,
+                 victim.merged ? victim.mask : sample_mask(*victim.triangle, x, y), x, y);
+      pool_[prev].next = victim.next;
+      if (tail_[pixel] == g) tail_[pixel] = prev;
+      --count_[pixel];
+      return false;
     }
   }
+  // 4. Sixteen different surfaces in one pixel: keep the larger areas.
+  std::uint32_t smallest = head_[pixel];
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (pool_[f].coverage < pool_[smallest].coverage) smallest = f;
+  }
+  if (coverage > pool_[smallest].coverage) {
+    pool_[smallest].triangle = t;
+    pool_[smallest].coverage = coverage;
+    pool_[smallest].merged = false;
+  }
+  return true;
+}
+
+void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                               std::uint32_t coverage) {
+  if (count_[pixel] >= kMaxFragmentsPerPixel && handle_overflow(pixel, x, y, t, coverage)) {
+    return;
+  }
   std::uint32_t index = std::uint32_t(pool_.size());
-  pool_.push_back(Fragment{t, kEnd, coverage});
+  pool_.push_back(Fragment{t, kEnd, coverage, 0, false});
   if (head_[pixel] == kEnd) {
     head_[pixel] = index;
   } else {
@@ -192,8 +233,8 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   const double cx = x + 0.5, cy = y + 0.5;
   const TriangleSetup* opaque = opaque_[pixel];
   const glm::vec3 behind = opaque != nullptr ? shade(*opaque, cx, cy, true) : background;
-  depth = opaque != nullptr ? float(opaque->depth_at(cx, cy))
-                            : std::numeric_limits<float>::infinity();
+  depth =
+      opaque != nullptr ? float(opaque->depth_at(cx, cy)) : std::numeric_limits<float>::infinity();
   if (head_[pixel] == kEnd) return behind;
 
   const DepthRange opaque_range =
@@ -202,46 +243,67 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   std::uint32_t cov[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
   int group[kMaxFragmentsPerPixel];
-  // Fragments of one layer of one surface form a group: in one pixel they are adjacent
-  // pieces of a tessellation, and their exact areas add.
-  struct Group {
-    const TriangleSetup* key;
-    std::uint32_t coverage;
-    DepthRange range;
-  } groups[kMaxFragmentsPerPixel];
-  int n = 0, group_count = 0;
+  // A group is one layer of one surface: fragments of the same mesh instance and facing,
+  // connected through shared vertices. Its pieces do not overlap, so their exact areas add.
+  std::uint64_t merged_mask[kMaxFragmentsPerPixel];
+  bool merged[kMaxFragmentsPerPixel];
+  int n = 0;
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     const TriangleSetup* t = pool_[f].triangle;
     DepthRange r = depth_range(*t, x, y);
     if (opaque != nullptr) {
-      DepthOrder order = r.max < opaque_range.min   ? DepthOrder::InFront
+      DepthOrder order = r.max < opaque_range.min    ? DepthOrder::InFront
                          : r.min >= opaque_range.max ? DepthOrder::Behind
                                                      : order_of(*t, *opaque, x, y);
       if (order == DepthOrder::Behind) continue;  // hidden: the opaque surface came later
       if (order == DepthOrder::Crossing) crossing = true;
     }
-    // A group is one layer: the same surface, and depth ranges that meet (adjacent pieces of
-    // a tessellation share an edge inside the pixel, so their ranges overlap). Two parts of
-    // one mesh at different depths (a fold in front of the back) are different layers.
-    int g = 0;
-    while (g < group_count &&
-           !(same_surface(*groups[g].key, *t) &&
-             !(r.max < groups[g].range.min || groups[g].range.max < r.min))) {
-      ++g;
-    }
-    if (g == group_count) groups[group_count++] = Group{t, 0, r};
-    groups[g].coverage += pool_[f].coverage;
-    groups[g].range.min = std::min(groups[g].range.min, r.min);
-    groups[g].range.max = std::max(groups[g].range.max, r.max);
     tri[n] = t;
     cov[n] = pool_[f].coverage;
     range[n] = r;
-    group[n] = g;
+    merged[n] = pool_[f].merged;
+    merged_mask[n] = pool_[f].mask;
     depth = std::min(depth, float(t->depth_at(cx, cy)));
     ++n;
   }
   if (n == 0) return behind;
+
+  // Union-find over at most 16 fragments, then per-group sums and depth ranges.
+  int parent[kMaxFragmentsPerPixel];
+  for (int i = 0; i < n; ++i) parent[i] = i;
+  auto root = [&](int i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      // A merged fragment already stands for adjacent pieces of its surface.
+      if (same_surface(*tri[i], *tri[j]) &&
+          (merged[i] || merged[j] || share_vertex(*tri[i], *tri[j]))) {
+        parent[root(j)] = root(i);
+      }
+    }
+  }
+  struct Group {
+    std::uint32_t coverage;
+    DepthRange range;
+  } groups[kMaxFragmentsPerPixel];
+  int group_of_root[kMaxFragmentsPerPixel];
+  int group_count = 0;
+  for (int i = 0; i < n; ++i) group_of_root[i] = -1;
+  for (int i = 0; i < n; ++i) {
+    int r = root(i);
+    if (group_of_root[r] < 0) {
+      group_of_root[r] = group_count;
+      groups[group_count++] = Group{0, range[i]};
+    }
+    Group& g = groups[group_of_root[r]];
+    group[i] = group_of_root[r];
+    g.coverage += cov[i];
+    g.range.min = std::min(g.range.min, range[i].min);
+    g.range.max = std::max(g.range.max, range[i].max);
+  }
 
   double weight[kMaxFragmentsPerPixel];
   int front = 0;  // the group nearest at its nearest point
@@ -252,7 +314,8 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   for (int g = 0; g < group_count; ++g) {
     if (g != front && !(groups[front].range.max < groups[g].range.min)) front_separate = false;
   }
-  if (front_separate && (group_count == 1 || groups[front].coverage >= std::uint32_t(kCoverageOne))) {
+  if (front_separate &&
+      (group_count == 1 || groups[front].coverage >= std::uint32_t(kCoverageOne))) {
     // One surface in front of everything else in this pixel: its exact areas add, and when
     // they fill the pixel nothing behind shows. (Weights are normalised below if > 1.)
     for (int i = 0; i < n; ++i) {
@@ -262,12 +325,13 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     // Visibility per sub-pixel sample, with per-sample depth from each plane.
     std::uint64_t mask[kMaxFragmentsPerPixel];
     int won[kMaxFragmentsPerPixel] = {};
-    for (int i = 0; i < n; ++i) mask[i] = sample_mask(*tri[i], x, y);
+    double winner_z[64];
+    for (int i = 0; i < n; ++i) mask[i] = merged[i] ? merged_mask[i] : sample_mask(*tri[i], x, y);
     for (int s = 0; s < 64; ++s) {
       const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
       int best = -1;
-      double best_z = opaque != nullptr ? opaque->depth_at(sx, sy)
-                                        : std::numeric_limits<double>::infinity();
+      double best_z =
+          opaque != nullptr ? opaque->depth_at(sx, sy) : std::numeric_limits<double>::infinity();
       std::uint32_t best_primitive = opaque != nullptr ? opaque->primitive : kNoTriangle;
       for (int i = 0; i < n; ++i) {
         if (!(mask[i] >> s & 1)) continue;
@@ -280,6 +344,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
         }
       }
       if (best >= 0) ++won[best];
+      winner_z[s] = best_z;
     }
     for (int i = 0; i < n; ++i) {
       int samples = std::popcount(mask[i]);
@@ -287,8 +352,14 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
       if (samples > 0) {
         share = double(won[i]) / samples;
       } else {
-        // Too small to own a sample: visible if it is in front of the opaque surface.
-        share = opaque == nullptr || range[i].min < opaque_range.min ? 1 : 0;
+        // Too small to own a sample: spread it over the pixel, and count the samples where
+        // its plane would be nearer than what won them.
+        int nearer = 0;
+        for (int s = 0; s < 64; ++s) {
+          const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
+          nearer += tri[i]->depth_at(sx, sy) < winner_z[s];
+        }
+        share = nearer / 64.0;
       }
       weight[i] = double(cov[i]) / kCoverageOne * share;
     }
@@ -320,8 +391,8 @@ void ABufferTile::resolve(const FrameTarget& target) {
 }
 
 std::size_t ABufferTile::scratch_bytes() const {
-  return opaque_.size() * (sizeof(void*) + 2 * sizeof(std::uint32_t) + 1 + sizeof(glm::vec3) +
-                           sizeof(float)) +
+  return opaque_.size() *
+             (sizeof(void*) + 2 * sizeof(std::uint32_t) + 1 + sizeof(glm::vec3) + sizeof(float)) +
          pool_.capacity() * sizeof(Fragment);
 }
 

@@ -6,7 +6,8 @@
 // crosses the opaque one inside the pixel is kept as a fragment instead). Partly covered
 // pixels keep a short list of fragments (triangle, 8.8 coverage), resolved front to back
 // when the tile is done:
-//  - one surface only (one mesh instance, one facing) in front of the opaque surface:
+//  - one layer (fragments of one mesh instance and facing, connected through shared
+//    vertices) in front of everything else, alone or filling the pixel:
 //    colour = sum(coverage_i * colour_i) + (1 - sum coverage) * behind; adjacent triangles of
 //    a tessellation add to exactly one pixel, so no background leaks through seams;
 //  - otherwise, per 8x8 sub-pixel samples from the same fixed-point edge functions, with
@@ -23,13 +24,15 @@
 
 namespace covrast::detail {
 
-/// Fragments one pixel keeps. Beyond it: drop fragments hidden by the opaque surface, then
-/// merge into a fragment of the same surface and facing (coverages add, the older
-/// triangle stands for both), else drop the farthest. Counted in overflow_count().
+/// Fragments one pixel keeps. Beyond it (counted in overflow_count()): drop fragments the
+/// opaque surface hides; else merge the new fragment into one of the same surface and facing
+/// (preferably an adjacent one): areas add, sample masks are united, the older triangle's
+/// plane and colour stand for both; else merge two such fragments already in the list; only
+/// when 16 different surfaces meet in one pixel is the fragment of least area dropped.
 inline constexpr int kMaxFragmentsPerPixel = 16;
 
 class ABufferTile {
-public:
+ public:
   explicit ABufferTile(int tile_px);
 
   void begin_tile(const PixelRect& rect);
@@ -41,16 +44,22 @@ public:
   std::size_t scratch_bytes() const;
   std::uint64_t overflow_count() const { return overflows_; }
 
-private:
+ private:
   struct Fragment {
     const TriangleSetup* triangle;
     std::uint32_t next;      ///< index into pool_, or kEnd
     std::uint32_t coverage;  ///< 8.8, 1/255 units
+    std::uint64_t mask;      ///< 8x8 sample mask, valid only when merged
+    bool merged;             ///< stands for several triangles of one surface
   };
   static constexpr std::uint32_t kEnd = 0xffffffffu;
 
   void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                     std::uint32_t coverage);
+  /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
+  bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                       std::uint32_t coverage);
+  void merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, int x, int y);
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
 
   int stride_;
