@@ -39,7 +39,6 @@ DepthRange depth_range(const TriangleSetup& t, int x, int y) {
 /// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
 /// difference is extreme at the corners: nearer at all four corners is in front; farther or
 /// equal at all four is behind (equal depth keeps the earlier triangle); else they cross.
-enum class DepthOrder { InFront, Behind, Crossing };
 
 DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y) {
   CornerDepths a = corner_depths(t, x, y), b = corner_depths(other, x, y);
@@ -100,6 +99,7 @@ std::uint64_t sample_mask(const TriangleSetup& t, int x, int y) {
 ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
   std::size_t n = std::size_t(tile_px) * tile_px;
   opaque_.resize(n);
+  opaque_z_.resize(n);
   head_.resize(n);
   tail_.resize(n);
   count_.resize(n);
@@ -115,26 +115,44 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   pool_.clear();
 }
 
+/// order_of, decided in most cases from the planes' difference at the pixel centre and a
+/// bound on how far it can move towards a corner: |d(corner) - d(centre)| <=
+/// (|ddz/dx| + |ddz/dy|) / 2. Near ties it falls back to the exact corner comparison.
+DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, double t_centre_z,
+                                             std::size_t pixel, int x, int y) const {
+  const TriangleSetup& o = *opaque_[pixel];
+  const double d = t_centre_z - opaque_z_[pixel];
+  const double reach = 0.5 * (std::fabs(t.dzdx - o.dzdx) + std::fabs(t.dzdy - o.dzdy));
+  constexpr double kMargin = 1e-12;  // far above the rounding of z in [0, 1]
+  if (d + reach < -kMargin) return DepthOrder::InFront;
+  if (d - reach > kMargin) return DepthOrder::Behind;
+  return order_of(t, o, x, y);
+}
+
 void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-  const TriangleSetup* opaque = opaque_[pixel];
-  if (coverage == std::uint32_t(kCoverageOne)) {
-    // Fast path: a fully covered pixel is an ordinary depth test, unless the planes cross.
-    if (opaque == nullptr) {
+  const double centre_z = t->depth_at(x + 0.5, y + 0.5);
+  if (opaque_[pixel] == nullptr) {
+    if (coverage == std::uint32_t(kCoverageOne)) {
       opaque_[pixel] = t;
+      opaque_z_[pixel] = centre_z;
       return;
     }
-    switch (order_of(*t, *opaque, x, y)) {
+  } else {
+    switch (order_against_opaque(*t, centre_z, pixel, x, y)) {
       case DepthOrder::InFront:
-        opaque_[pixel] = t;
-        return;
-      case DepthOrder::Behind:
-        return;
-      case DepthOrder::Crossing:
+        // A fully covered pixel is an ordinary depth test.
+        if (coverage == std::uint32_t(kCoverageOne)) {
+          opaque_[pixel] = t;
+          opaque_z_[pixel] = centre_z;
+          return;
+        }
         break;
+      case DepthOrder::Behind:
+        return;  // hidden everywhere in the pixel
+      case DepthOrder::Crossing:
+        break;  // kept as a fragment, resolved per sample
     }
-  } else if (opaque != nullptr && order_of(*t, *opaque, x, y) == DepthOrder::Behind) {
-    return;  // hidden everywhere in the pixel
   }
   add_fragment(pixel, x, y, t, coverage);
 }

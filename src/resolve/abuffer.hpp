@@ -31,6 +31,9 @@ namespace covrast::detail {
 /// when 16 different surfaces meet in one pixel is the fragment of least area dropped.
 inline constexpr int kMaxFragmentsPerPixel = 16;
 
+/// How one triangle's depth plane lies against another's over a pixel.
+enum class DepthOrder { InFront, Behind, Crossing };
+
 class ABufferTile {
  public:
   explicit ABufferTile(int tile_px);
@@ -54,6 +57,8 @@ class ABufferTile {
   };
   static constexpr std::uint32_t kEnd = 0xffffffffu;
 
+  DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z, std::size_t pixel,
+                                  int x, int y) const;
   void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                     std::uint32_t coverage);
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
@@ -65,6 +70,7 @@ class ABufferTile {
   int stride_;
   PixelRect rect_;
   std::vector<const TriangleSetup*> opaque_;  ///< per pixel, null = background
+  std::vector<double> opaque_z_;              ///< per pixel, the opaque plane at the centre
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
