@@ -269,7 +269,10 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     const TriangleSetup* t = pool_[f].triangle;
-    DepthRange r = depth_range(*t, x, y);
+    // Range over the pixel from the centre: z(centre) -+ (|dz/dx| + |dz/dy|) / 2.
+    const double centre_z = t->depth_at(cx, cy);
+    const double reach = 0.5 * (std::fabs(t->dzdx) + std::fabs(t->dzdy));
+    const DepthRange r{centre_z - reach, centre_z + reach};
     if (opaque != nullptr) {
       DepthOrder order = r.max < opaque_range.min    ? DepthOrder::InFront
                          : r.min >= opaque_range.max ? DepthOrder::Behind
@@ -282,7 +285,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     range[n] = r;
     merged[n] = pool_[f].merged;
     merged_mask[n] = pool_[f].mask;
-    depth = std::min(depth, float(t->depth_at(cx, cy)));
+    depth = std::min(depth, float(centre_z));
     ++n;
   }
   if (n == 0) return behind;
