@@ -17,6 +17,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "resolve/abuffer.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -393,13 +395,13 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
   // quad larger than the square, or a second tessellated square (cells of 0.53 px).
   const Case cases[] = {{{0, 0, 0}, {255, 255, 255}, 24, Behind::Nothing},
                         {{200, 30, 90}, {10, 250, 128}, 24, Behind::Nothing},
-                        {{0, 0, 0}, {255, 255, 255}, 200, Behind::Nothing},
+                        {{0, 0, 0}, {255, 255, 255}, 400, Behind::Nothing},
                         {{20, 120, 220}, {255, 0, 255}, 60, Behind::Nothing},
                         {{0, 0, 0}, {90, 90, 90}, 24, Behind::QuadFirst},
                         {{0, 0, 0}, {90, 90, 90}, 24, Behind::QuadLast},
                         {{0, 0, 0}, {90, 90, 90}, 24, Behind::LayerFirst},
-                        {{0, 0, 0}, {90, 90, 90}, 200, Behind::LayerFirst},
-                        {{0, 0, 0}, {90, 90, 90}, 200, Behind::LayerLast}};
+                        {{0, 0, 0}, {90, 90, 90}, 400, Behind::LayerFirst},
+                        {{0, 0, 0}, {90, 90, 90}, 400, Behind::LayerLast}};
   for (const Case& c : cases) {
     Scene s = make_scene(96, 96, from_codes(c.codes_b[0], c.codes_b[1], c.codes_b[2]));
     auto behind = [&] {
@@ -447,7 +449,7 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
                  << "; fragment overflows " << result.stats.fragment_overflows);
     CHECK(checked == 77 * 77);
     CHECK(wrong == 0);
-    if (c.cells == 200) CHECK(result.stats.fragment_overflows > 0);
+    if (c.cells == 400) CHECK(result.stats.fragment_overflows > 0);  // 0.2 px cells
   }
 }
 
@@ -534,7 +536,7 @@ TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]
   }
 }
 
-// Near the poles of the sphere more than kMaxFragmentsPerPixel (16) triangles, front and
+// Near the poles of the sphere more than kMaxFragmentsPerPixel triangles, front and
 // back faces, touch one outline pixel: this exercises the overflow merge (masks united) on
 // the per-sample path. (It once failed by 29/255 when merges dropped the masks.)
 TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage]") {
@@ -592,15 +594,16 @@ TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[c
   CHECK(c.mean_diff8 < 0.01);
 }
 
-// A fan of 24 slivers of one mesh meets at (20.25, 20.5), covering x < 20.25 of pixel
-// (20, 20) (a quarter); a triangle of another mesh behind covers x < 20.6 of that pixel. All
-// 25 touch the pixel. Expected (linear): red 0.25, blue 0.35, black 0.4. Overflow must
-// neither drop the farther triangle nor lose the merged slivers' sample masks.
+// A fan of kMaxFragmentsPerPixel + 8 slivers of one mesh meets at (20.25, 20.5), covering x < 20.25
+// of pixel (20, 20) (a quarter); a triangle of another mesh behind covers x < 20.6 of that pixel.
+// All 25 touch the pixel. Expected (linear): red 0.25, blue 0.35, black 0.4. Overflow must neither
+// drop the farther triangle nor lose the merged slivers' sample masks.
 TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places", "[coverage]") {
   for (bool back_first : {false, true}) {
     Scene s = make_scene(40, 40, glm::vec3(0));
     std::vector<ScreenVertex> fan;
-    constexpr int kSpokes = 24;
+    constexpr int kSpokes =
+        covrast::detail::kMaxFragmentsPerPixel + 8;  // enough to overflow the list
     for (int k = 0; k < kSpokes; ++k) {
       const double a0 = kPi / 2 + kPi * k / kSpokes, a1 = kPi / 2 + kPi * (k + 1) / kSpokes;
       fan.push_back({20.25, 20.5, 0.5});
@@ -616,11 +619,11 @@ TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places", 
     const Comparison c = compare(result.color, ref);
     const std::uint8_t* p = result.color.pixel(20, 20);
     const glm::dvec3 r = ref.linear[20 * 40 + 20];
-    WARN("fan of 24 over a triangle behind, "
-         << (back_first ? "back" : "fan") << " drawn first: " << describe(c)
-         << "; pixel (20, 20) = (" << int(p[0]) << ", " << int(p[1]) << ", " << int(p[2])
-         << "), reference (" << encode8(r.r) << ", " << encode8(r.g) << ", " << encode8(r.b)
-         << "); fragment overflows " << result.stats.fragment_overflows);
+    WARN("fan of " << kSpokes << " over a triangle behind, " << (back_first ? "back" : "fan")
+                   << " drawn first: " << describe(c) << "; pixel (20, 20) = (" << int(p[0]) << ", "
+                   << int(p[1]) << ", " << int(p[2]) << "), reference (" << encode8(r.r) << ", "
+                   << encode8(r.g) << ", " << encode8(r.b) << "); fragment overflows "
+                   << result.stats.fragment_overflows);
     CHECK(result.stats.fragment_overflows > 0);
     CHECK(c.max_diff_linear <= kMaskToleranceLinear);
   }

@@ -157,11 +157,21 @@ void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t covera
   add_fragment(pixel, x, y, t, coverage);
 }
 
-void ABufferTile::merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, int x,
-                             int y) {
-  if (!f.merged) f.mask = sample_mask(*f.triangle, x, y);
+void ABufferTile::merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask,
+                             glm::vec3 color, int x, int y) {
+  if (!f.merged) {
+    f.mask = sample_mask(*f.triangle, x, y);
+    f.color = shade(*f.triangle, x + 0.5, y + 0.5, true);
+    f.weight = f.coverage;
+    f.merged = true;
+  }
   f.mask |= mask;
-  f.merged = true;
+  // Running coverage-weighted mean of the pieces' colours.
+  const std::uint32_t weight = f.weight + coverage;
+  if (weight > 0) {
+    f.color = (f.color * float(f.weight) + color * float(coverage)) / float(weight);
+  }
+  f.weight = weight;
   f.coverage = std::min<std::uint32_t>(f.coverage + coverage, kCoverageOne);
 }
 
@@ -200,7 +210,8 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     if (same == kEnd) same = f;
   }
   if (same != kEnd) {
-    merge_into(pool_[same], coverage, sample_mask(*t, x, y), x, y);
+    merge_into(pool_[same], coverage, sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x,
+               y);
     return true;
   }
   // 3. Merge two fragments of one surface already in the list, freeing a slot.
@@ -209,8 +220,10 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     for (std::uint32_t g = pool_[f].next; g != kEnd; prev = g, g = pool_[g].next) {
       if (!same_surface(*pool_[f].triangle, *pool_[g].triangle)) continue;
       Fragment& victim = pool_[g];
-      merge_into(pool_[f], victim.coverage,
-                 victim.merged ? victim.mask : sample_mask(*victim.triangle, x, y), x, y);
+      merge_into(pool_[f], victim.merged ? victim.weight : victim.coverage,
+                 victim.merged ? victim.mask : sample_mask(*victim.triangle, x, y),
+                 victim.merged ? victim.color : shade(*victim.triangle, x + 0.5, y + 0.5, true), x,
+                 y);
       pool_[prev].next = victim.next;
       if (tail_[pixel] == g) tail_[pixel] = prev;
       --count_[pixel];
@@ -236,7 +249,7 @@ void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSe
     return;
   }
   std::uint32_t index = std::uint32_t(pool_.size());
-  pool_.push_back(Fragment{t, kEnd, coverage, 0, false});
+  pool_.push_back(Fragment{t, kEnd, coverage, 0, glm::vec3(0.0f), 0, false});
   if (head_[pixel] == kEnd) {
     head_[pixel] = index;
   } else {
@@ -265,6 +278,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   // connected through shared vertices. Its pieces do not overlap, so their exact areas add.
   std::uint64_t merged_mask[kMaxFragmentsPerPixel];
   bool merged[kMaxFragmentsPerPixel];
+  glm::vec3 merged_color[kMaxFragmentsPerPixel];
   int n = 0;
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
@@ -284,6 +298,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     cov[n] = pool_[f].coverage;
     range[n] = r;
     merged[n] = pool_[f].merged;
+    merged_color[n] = pool_[f].color;
     merged_mask[n] = pool_[f].mask;
     depth = std::min(depth, float(centre_z));
     ++n;
@@ -392,7 +407,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
   for (int i = 0; i < n; ++i) {
     if (weight[i] == 0) continue;
-    glm::vec3 c = shade(*tri[i], cx, cy, true);
+    const glm::vec3 c = merged[i] ? merged_color[i] : shade(*tri[i], cx, cy, true);
     double w = weight[i] * scale;
     r += w * c.r;
     g += w * c.g;

@@ -28,8 +28,8 @@ namespace covrast::detail {
 /// opaque surface hides; else merge the new fragment into one of the same surface and facing
 /// (preferably an adjacent one): areas add, sample masks are united, the older triangle's
 /// plane and colour stand for both; else merge two such fragments already in the list; only
-/// when 16 different surfaces meet in one pixel is the fragment of least area dropped.
-inline constexpr int kMaxFragmentsPerPixel = 16;
+/// when 32 different surfaces meet in one pixel is the fragment of least area dropped.
+inline constexpr int kMaxFragmentsPerPixel = 32;
 
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
@@ -53,6 +53,8 @@ class ABufferTile {
     std::uint32_t next;      ///< index into pool_, or kEnd
     std::uint32_t coverage;  ///< 8.8, 1/255 units
     std::uint64_t mask;      ///< 8x8 sample mask, valid only when merged
+    glm::vec3 color;         ///< when merged: coverage-weighted mean colour (linear)
+    std::uint32_t weight;    ///< when merged: summed coverage behind `color` (unclamped)
     bool merged;             ///< stands for several triangles of one surface
   };
   static constexpr std::uint32_t kEnd = 0xffffffffu;
@@ -64,7 +66,9 @@ class ABufferTile {
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
-  void merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, int x, int y);
+  /// Merges a piece (coverage, sample mask, colour at the pixel centre) into `f`.
+  void merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, glm::vec3 color, int x,
+                  int y);
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
 
   int stride_;
