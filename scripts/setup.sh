@@ -7,7 +7,7 @@ set -euo pipefail
 packages=(
   cmake ninja-build g++ clang pkg-config
   libglm-dev libtbb-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
-  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev python3
 )
 
 missing=()
