@@ -19,7 +19,7 @@
 //
 // Depth is float: z_l = float(depth at the group origin) + dz_l, dz_l = float(dzdx) ox_l +
 // float(dzdy) oy_l [pixels], evaluated as separate IEEE multiplies and adds (no FMA), so
-// every target gives the same bits. Colour is fixed point: round(clamp(c, 0, 1) * 2^23)
+// every target gives the same bits. Colour is fixed point: round(clamp(c, 0, 1) * 2^22)
 // per channel, so the box-filter sums of up to 256 samples are exact uint32 integers and
 // their order does not matter.
 #pragma once
@@ -37,8 +37,9 @@ inline constexpr int kGroupLaneBlock = 16;
 inline constexpr std::int32_t kEdgeClamp = std::int32_t(1) << 29;
 /// c of padding lanes on edge 0: F + c < 0 for every F <= kEdgeClamp, so never inside.
 inline constexpr std::int32_t kPaddingOffset = -(kEdgeClamp + 1);
-/// Fixed-point colour: 1.0 = 2^23, so 256 samples sum to at most 2^31.
-inline constexpr int kColorFractionBits = 23;
+/// Fixed-point colour: 1.0 = 2^22, so 256 samples sum to at most 2^30: the sum fits a
+/// signed int32 too, which matters because some targets reduce lanes with signed adds.
+inline constexpr int kColorFractionBits = 22;
 inline constexpr double kColorOne = double(1 << kColorFractionBits);
 
 /// The sample layout of one group, fixed per rasterizer.

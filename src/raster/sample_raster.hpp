@@ -101,7 +101,7 @@ class SampleRasterizer final : public TileRasterizer {
   std::uint32_t background_q_[3] = {0, 0, 0};
 };
 
-/// Fixed-point linear colour of sample_kernel.hpp: round(clamp(c, 0, 1) * 2^23).
+/// Fixed-point linear colour of sample_kernel.hpp: round(clamp(c, 0, 1) * 2^22).
 std::uint32_t quantize_color(float linear);
 
 }  // namespace covrast::detail
