@@ -10,7 +10,11 @@
 
 #include <covrast/scene.hpp>
 
+#include <algorithm>
 #include <cstdint>
+#include <memory>
+#include <new>
+#include <utility>
 #include <vector>
 
 namespace covrast::detail {
@@ -31,10 +35,29 @@ struct SnappedVertex {
 /// inside every plane, their snapped screen position (shared by all their triangles).
 struct InstanceVertices {
   std::vector<glm::dvec4> clip;
-  std::vector<std::uint8_t> outcode;     ///< bit p set: outside clip plane p
-  std::vector<SnappedVertex> snapped;    ///< valid where outcode == 0
-  std::vector<glm::vec3> color_linear;   ///< only for ColorSource::Vertex
+  std::vector<std::uint8_t> outcode;    ///< bit p set: outside clip plane p
+  std::vector<SnappedVertex> snapped;   ///< valid where outcode == 0
+  std::vector<glm::vec3> color_linear;  ///< only for ColorSource::Vertex
 };
+
+/// An allocator whose value-less construct() default-initialises: a vector of it grows
+/// without zeroing the new elements first (setup writes every field of each triangle;
+/// zeroing 112 bytes per triangle was a visible share of setup time).
+template <class T>
+struct DefaultInitAllocator : std::allocator<T> {
+  using std::allocator<T>::allocator;
+  template <class U>
+  void construct(U* p) noexcept {
+    ::new (static_cast<void*>(p)) U;
+  }
+  template <class U, class... Args>
+  void construct(U* p, Args&&... args) {
+    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
+  }
+};
+
+/// One chunk's set-up triangles, as the pipeline keeps them.
+using SetupVector = std::vector<TriangleSetup, DefaultInitAllocator<TriangleSetup>>;
 
 struct SetupCounters {
   std::uint64_t culled = 0;   ///< outside the view volume, or zero area after snapping
@@ -42,12 +65,17 @@ struct SetupCounters {
 };
 
 class GeometryFrontEnd {
-public:
+ public:
   GeometryFrontEnd(const Scene& scene, int width_px, int height_px);
 
   std::uint64_t triangle_count() const { return first_triangle_.back(); }
   std::uint32_t chunk_count() const {
     return std::uint32_t((triangle_count() + kTrianglesPerChunk - 1) / kTrianglesPerChunk);
+  }
+  /// Input triangles of one chunk (kTrianglesPerChunk, fewer in the last one).
+  std::uint32_t chunk_triangle_count(std::uint32_t chunk) const {
+    return std::uint32_t(std::min<std::uint64_t>(
+        kTrianglesPerChunk, triangle_count() - std::uint64_t(chunk) * kTrianglesPerChunk));
   }
   std::size_t instance_count() const { return scene_.meshes.size(); }
 
@@ -58,22 +86,38 @@ public:
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order.
   void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
                    SetupCounters& counters) const;
+  /// The same, and appends each emitted triangle's touched pixels clamped to the image
+  /// to `bounds` (for binning).
+  void setup_chunk(std::uint32_t chunk, SetupVector& out, std::vector<PixelBounds16>& bounds,
+                   SetupCounters& counters) const;
 
-private:
+ private:
   SnappedVertex snap(const glm::dvec4& clip) const;
   unsigned outcode(const glm::dvec4& clip) const;
-  void emit_triangle(const SnappedVertex* v, const glm::vec3* color, bool flat,
-                     std::uint32_t primitive, std::uint32_t surface,
-                     std::vector<TriangleSetup>& out, SetupCounters& counters) const;
-  void setup_triangle(std::size_t instance, std::uint32_t local_index, std::uint32_t primitive,
-                      std::vector<TriangleSetup>& out, SetupCounters& counters) const;
+  /// Where emitted triangles go: `bounds` may be null.
+  struct Sink {
+    std::vector<TriangleSetup>* out;  ///< exactly one of out and setups is set
+    SetupVector* setups;
+    std::vector<PixelBounds16>* bounds;
+    SetupCounters& counters;
+    /// A new triangle at the end of the output, its fields to be written.
+    TriangleSetup& next() {
+      return setups != nullptr ? setups->emplace_back() : out->emplace_back();
+    }
+  };
+  void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                     const glm::vec3* color, bool flat, std::uint32_t primitive,
+                     std::uint32_t surface, Sink& sink) const;
+  void clip_triangle(std::size_t instance, const std::uint32_t* idx, const glm::vec3* color,
+                     bool flat, unsigned out_any, std::uint32_t primitive, Sink& sink) const;
+  void setup_range(std::uint32_t chunk, Sink& sink) const;
 
   const Scene& scene_;
   int width_px_;
   int height_px_;
   glm::dmat4 view_projection_;
-  double guard_x_;  ///< guard band half-extent in NDC units, x
-  double guard_y_;  ///< same, y
+  double guard_x_;        ///< guard band half-extent in NDC units, x
+  double guard_y_;        ///< same, y
   glm::dvec4 planes_[6];  ///< homogeneous clip planes: inside where dot(plane, v) >= 0
   std::vector<std::uint64_t> first_triangle_;  ///< prefix sums of triangle counts
   std::vector<InstanceVertices> vertices_;

@@ -57,15 +57,22 @@ struct PixelRect {
 
 /// Pixels that the triangle's area can touch: floor of the minimum to ceil of the maximum.
 inline PixelRect touched_pixels(const TriangleSetup& t) {
-  std::int32_t minx = std::min({t.x_fx8[0], t.x_fx8[1], t.x_fx8[2]});
-  std::int32_t maxx = std::max({t.x_fx8[0], t.x_fx8[1], t.x_fx8[2]});
-  std::int32_t miny = std::min({t.y_fx8[0], t.y_fx8[1], t.y_fx8[2]});
-  std::int32_t maxy = std::max({t.y_fx8[0], t.y_fx8[1], t.y_fx8[2]});
+  // Pairwise min/max (the initializer-list forms compile to a loop with branches).
+  const std::int32_t minx = std::min(t.x_fx8[0], std::min(t.x_fx8[1], t.x_fx8[2]));
+  const std::int32_t maxx = std::max(t.x_fx8[0], std::max(t.x_fx8[1], t.x_fx8[2]));
+  const std::int32_t miny = std::min(t.y_fx8[0], std::min(t.y_fx8[1], t.y_fx8[2]));
+  const std::int32_t maxy = std::max(t.y_fx8[0], std::max(t.y_fx8[1], t.y_fx8[2]));
   // Arithmetic shift = floor division by 256 for negative values too.
   return PixelRect{minx >> kSubpixelBits, miny >> kSubpixelBits,
                    (maxx + kSubpixelOne - 1) >> kSubpixelBits,
                    (maxy + kSubpixelOne - 1) >> kSubpixelBits};
 }
+
+/// touched_pixels clamped to the image, in 16 bits (image sides are at most 16384 px):
+/// all that binning needs, 8 bytes per triangle instead of the whole setup.
+struct PixelBounds16 {
+  std::uint16_t x0, y0, x1, y1;  ///< [x0, x1) x [y0, y1), never empty
+};
 
 inline PixelRect intersect(const PixelRect& a, const PixelRect& b) {
   return PixelRect{std::max(a.x0, b.x0), std::max(a.y0, b.y0), std::min(a.x1, b.x1),

@@ -96,7 +96,8 @@ struct Renderer::Impl {
   int threads;
   detail::TileGrid grid;
   detail::GeometryFrontEnd front_end;
-  std::vector<std::vector<TriangleSetup>> chunk_triangles;
+  std::vector<detail::SetupVector> chunk_triangles;
+  std::vector<std::vector<detail::PixelBounds16>> chunk_bounds;  ///< per triangle, for binning
   std::vector<detail::ChunkBins> chunk_bins;
   tbb::task_arena arena;
   tbb::enumerable_thread_specific<std::vector<std::uint32_t>> bin_scratch;
@@ -117,6 +118,7 @@ struct Renderer::Impl {
           return detail::make_tile_rasterizer(mode, tile);
         }) {
     chunk_triangles.resize(front_end.chunk_count());
+    chunk_bounds.resize(front_end.chunk_count());
     chunk_bins.resize(front_end.chunk_count());
   }
 };
@@ -177,12 +179,18 @@ RenderResult Renderer::render_frame() {
     });
     // Setup, part 2: clip, snap and set up each chunk of triangles.
     tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
+      // Room for one output per input (clipping can add more): the first frame then
+      // fills each buffer without reallocating and copying it.
       im.chunk_triangles[c].clear();
-      im.front_end.setup_chunk(c, im.chunk_triangles[c], im.setup_counters.local());
+      im.chunk_triangles[c].reserve(im.front_end.chunk_triangle_count(c));
+      im.chunk_bounds[c].clear();
+      im.chunk_bounds[c].reserve(im.front_end.chunk_triangle_count(c));
+      im.front_end.setup_chunk(c, im.chunk_triangles[c], im.chunk_bounds[c],
+                               im.setup_counters.local());
     });
     t1 = Clock::now();
     tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
-      detail::bin_chunk(im.grid, im.chunk_triangles[c], im.chunk_bins[c], im.bin_scratch.local());
+      detail::bin_chunk(im.grid, im.chunk_bounds[c], im.chunk_bins[c], im.bin_scratch.local());
     });
     t2 = Clock::now();
     tbb::parallel_for(
