@@ -114,9 +114,8 @@ struct Renderer::Impl {
         grid(w, h, o.tile),
         front_end(s, w, h),
         arena(t),
-        rasterizers([mode = o.mode, tile = o.tile] {
-          return detail::make_tile_rasterizer(mode, tile);
-        }) {
+        rasterizers(
+            [mode = o.mode, tile = o.tile] { return detail::make_tile_rasterizer(mode, tile); }) {
     chunk_triangles.resize(front_end.chunk_count());
     chunk_bounds.resize(front_end.chunk_count());
     chunk_bins.resize(front_end.chunk_count());
@@ -193,20 +192,21 @@ RenderResult Renderer::render_frame() {
       detail::bin_chunk(im.grid, im.chunk_bounds[c], im.chunk_bins[c], im.bin_scratch.local());
     });
     t2 = Clock::now();
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, im.grid.tile_count(), 1), [&](const tbb::blocked_range<int>& r) {
-          detail::TileRasterizer& raster = *im.rasterizers.local();
-          for (int tile = r.begin(); tile < r.end(); ++tile) {
-            raster.begin_tile(im.grid.tile_rect(tile), target);
-            for (std::size_t c = 0; c < im.chunk_bins.size(); ++c) {
-              const auto& tris = im.chunk_triangles[c];
-              for (std::uint32_t i : im.chunk_bins[c].tile(tile)) raster.draw(tris[i]);
-            }
-            Clock::time_point r0 = Clock::now();
-            raster.end_tile(target);
-            im.resolve_thread_ms.local() += ms_between(r0, Clock::now());
-          }
-        });
+    tbb::parallel_for(tbb::blocked_range<int>(0, im.grid.tile_count(), 1),
+                      [&](const tbb::blocked_range<int>& r) {
+                        detail::TileRasterizer& raster = *im.rasterizers.local();
+                        for (int tile = r.begin(); tile < r.end(); ++tile) {
+                          raster.begin_tile(im.grid.tile_rect(tile), target);
+                          for (std::size_t c = 0; c < im.chunk_bins.size(); ++c) {
+                            const auto& tris = im.chunk_triangles[c];
+                            for (std::uint32_t i : im.chunk_bins[c].tile(tile))
+                              raster.draw(tris[i]);
+                          }
+                          Clock::time_point r0 = Clock::now();
+                          raster.end_tile(target);
+                          im.resolve_thread_ms.local() += ms_between(r0, Clock::now());
+                        }
+                      });
     t3 = Clock::now();
   });
 

@@ -23,7 +23,7 @@ struct FrameTarget {
 };
 
 class TileRasterizer {
-public:
+ public:
   virtual ~TileRasterizer() = default;
   virtual void begin_tile(const PixelRect& rect, const FrameTarget& target) = 0;
   virtual void draw(const TriangleSetup& triangle) = 0;
