@@ -865,6 +865,9 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
     targets.push_back(bits & -bits);
   }
   const Image baseline = render(s, ModeKind::Coverage, 1, 64).color;
+  // The aliased mode's row kernel dispatches through the same Highway target choice
+  // (hwy::SetSupportedTargetsForTest is global), so it is checked here as well.
+  const Image aliased_baseline = render(s, ModeKind::Aliased, 1, 64).color;
   // The scene is not trivial: many distinct colours (edges anti-aliased).
   int edge_pixels = 0;
   for (int y = 0; y < baseline.height; ++y) {
@@ -883,10 +886,12 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
         const Image img = render(s, ModeKind::Coverage, threads, tile).color;
         REQUIRE(img.width == baseline.width);
         CHECK(img.rgb == baseline.rgb);
+        CHECK(render(s, ModeKind::Aliased, threads, tile).color.rgb == aliased_baseline.rgb);
       }
     }
   }
   covrast::detail::force_coverage_kernel_target(0);
-  WARN("determinism checked on targets: " << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
+  WARN("determinism (coverage and aliased) checked on targets: "
+       << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
   CHECK(targets.size() >= 1);
 }
