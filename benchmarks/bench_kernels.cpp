@@ -62,30 +62,12 @@ std::vector<KernelJob> make_kernel_jobs(double min_px, double max_px, std::uint3
       job.columns = std::make_unique<CoverageColumns>();
       job.sign = tri.sign;
       job.lanes = std::min(kColumnGroup, r.x1 - g);
-      int first = INT_MAX, end = INT_MIN, interior_begin = INT_MIN, interior_end = INT_MAX;
-      for (int lane = 0; lane < kColumnGroup; ++lane) {
-        if (lane >= job.lanes) {
-          for (int e = 0; e < 3; ++e) {
-            job.columns->t_left[e][lane] = job.columns->t_right[e][lane] = 0.0f;
-            job.columns->width_q[e][lane] = job.columns->slope_q[e][lane] = 0.0f;
-            job.columns->base_row[e][lane] = 0;
-          }
-          continue;
-        }
-        ColumnRows rows = setup_column(tri, g + lane, *job.columns, lane);
-        if (rows.first >= rows.end) continue;
-        first = std::min(first, rows.first);
-        end = std::max(end, rows.end);
-        interior_begin = std::max(interior_begin, rows.interior_begin);
-        interior_end = std::min(interior_end, rows.interior_end);
-      }
-      first = std::max(first, r.y0);
-      end = std::min(end, r.y1);
-      if (first >= end) continue;
-      job.first = first;
-      job.end = end;
-      job.interior_begin = std::clamp(interior_begin, first, end);
-      job.interior_end = std::clamp(interior_end, job.interior_begin, end);
+      const GroupRows rows = setup_column_group(tri, g, job.lanes, r.y0, r.y1, *job.columns);
+      if (rows.empty()) continue;
+      job.first = rows.first;
+      job.end = rows.end;
+      job.interior_begin = rows.interior_begin;
+      job.interior_end = rows.interior_end;
       jobs.push_back(std::move(job));
     }
   }

@@ -160,34 +160,18 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
   std::vector<std::uint16_t> buf(std::size_t(r.y1 - r.y0) * kColumnGroup);
   for (int g = r.x0; g < r.x1; g += kColumnGroup) {
     const int lanes = std::min(kColumnGroup, r.x1 - g);
-    int first = INT32_MAX, end = INT32_MIN, interior_begin = INT32_MIN, interior_end = INT32_MAX;
-    for (int lane = 0; lane < kColumnGroup; ++lane) {
-      if (lane >= lanes) {
-        for (int e = 0; e < 3; ++e) {
-          cols.t_left[e][lane] = cols.t_right[e][lane] = 0.0f;
-          cols.width_q[e][lane] = cols.slope_q[e][lane] = 0.0f;
-          cols.base_row[e][lane] = 0;
-        }
-        continue;
-      }
-      const ColumnRows rows = covrast::detail::setup_column(tri, g + lane, cols, lane);
-      if (rows.first >= rows.end) continue;
-      first = std::min(first, rows.first);
-      end = std::max(end, rows.end);
-      interior_begin = std::max(interior_begin, rows.interior_begin);
-      interior_end = std::min(interior_end, rows.interior_end);
-    }
+    // The same set-up as CoverageRasterizer::draw.
+    const covrast::detail::GroupRows rows =
+        covrast::detail::setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
     // Poison the buffer: a row of [first, end) that nothing writes shows up as a mismatch.
     std::fill(buf.begin(), buf.end(), kPoison);
     int copy_begin = r.y0, copy_end = r.y1;
     if (mode == RowMode::AllRows) {
       fn(cols, 0, r.y0, r.y1, tri.sign, buf.data(), kColumnGroup);
     } else {
-      first = std::max(first, r.y0);
-      end = std::min(end, r.y1);
-      if (first >= end) continue;
-      interior_begin = std::clamp(interior_begin, first, end);
-      interior_end = std::clamp(interior_end, interior_begin, end);
+      if (rows.empty()) continue;
+      const int first = rows.first, end = rows.end;
+      const int interior_begin = rows.interior_begin, interior_end = rows.interior_end;
       fn(cols, 0, first, interior_begin, tri.sign,
          buf.data() + std::size_t(first - r.y0) * kColumnGroup, kColumnGroup);
       for (int y = interior_begin; y < interior_end; ++y) {

@@ -21,7 +21,7 @@ namespace covrast::detail {
 namespace {
 
 class CoverageRasterizer final : public TileRasterizer {
-public:
+ public:
   CoverageRasterizer(int tile_px, bool blend)
       : tile_px_(tile_px),
         blend_(blend),
@@ -52,40 +52,21 @@ public:
     const CoverageTriangle tri = make_coverage_triangle(t);
     CoverageColumns& cols = *columns_;
     for (int g = r.x0; g < r.x1; g += kColumnGroup) {
-      // Set up the group's columns; lanes past the span get zero width.
       const int lanes = std::min(kColumnGroup, r.x1 - g);
-      int first = INT_MAX, end = INT_MIN, interior_begin = INT_MIN, interior_end = INT_MAX;
-      for (int lane = 0; lane < kColumnGroup; ++lane) {
-        if (lane >= lanes) {
-          for (int e = 0; e < 3; ++e) {
-            cols.t_left[e][lane] = cols.t_right[e][lane] = 0.0f;
-            cols.width_q[e][lane] = cols.slope_q[e][lane] = 0.0f;
-            cols.base_row[e][lane] = 0;
-          }
-          continue;
-        }
-        ColumnRows rows = setup_column(tri, g + lane, cols, lane);
-        if (rows.first >= rows.end) continue;
-        first = std::min(first, rows.first);
-        end = std::max(end, rows.end);
-        interior_begin = std::max(interior_begin, rows.interior_begin);
-        interior_end = std::min(interior_end, rows.interior_end);
-      }
-      first = std::max(first, r.y0);
-      end = std::min(end, r.y1);
-      if (first >= end) continue;
-      interior_begin = std::clamp(interior_begin, first, end);
-      interior_end = std::clamp(interior_end, interior_begin, end);
+      const GroupRows rows = setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
+      if (rows.empty()) continue;
+      const int first = rows.first, end = rows.end;
+      const int interior_begin = rows.interior_begin, interior_end = rows.interior_end;
       std::uint16_t* out = plane_.data() + std::size_t(first - rect_.y0) * plane_stride_;
       // Top partial run, interior run, bottom partial run.
       kernel_(cols, 0, first, interior_begin, tri.sign, out, plane_stride_);
       for (int y = interior_begin; y < interior_end; ++y) {
         std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
-        for (int lane = 0; lane < kColumnGroup; ++lane) row[lane] = std::uint16_t(cols.width_q[0][lane]);
+        for (int lane = 0; lane < kColumnGroup; ++lane)
+          row[lane] = std::uint16_t(cols.width_q[0][lane]);
       }
-      kernel_(cols, 0, interior_end, end,
-              tri.sign, plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_,
-              plane_stride_);
+      kernel_(cols, 0, interior_end, end, tri.sign,
+              plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_, plane_stride_);
       consume(t, g, lanes, first, end);
     }
   }
@@ -111,7 +92,7 @@ public:
   /// Kernel used for the partial runs; tests swap in the scalar twin.
   CoverageRowsFn kernel_ = coverage_rows_simd;
 
-private:
+ private:
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
   void consume(const TriangleSetup& t, int g, int lanes, int first, int end) {
     for (int y = first; y < end; ++y) {

@@ -47,18 +47,18 @@ inline constexpr float kFlatEdgeEps = 1.0f / 1024.0f;
 /// Per-column inputs of the three edges, structure of arrays over columns. Index 0 = ac,
 /// 1 = ab, 2 = bc. Lanes of columns a triangle does not span have width 0 (term = 0).
 struct CoverageColumns {
-  alignas(64) float t_left[3][kMaxSpanColumns];   ///< yl - base_row [pixels]
-  alignas(64) float t_right[3][kMaxSpanColumns];  ///< yr - base_row [pixels]
-  alignas(64) float width_q[3][kMaxSpanColumns];  ///< 65280 * (xr - xl), integer-valued
-  alignas(64) float slope_q[3][kMaxSpanColumns];  ///< width_q / (yr - yl), 0 when flat
+  alignas(64) float t_left[3][kMaxSpanColumns];           ///< yl - base_row [pixels]
+  alignas(64) float t_right[3][kMaxSpanColumns];          ///< yr - base_row [pixels]
+  alignas(64) float width_q[3][kMaxSpanColumns];          ///< 65280 * (xr - xl), integer-valued
+  alignas(64) float slope_q[3][kMaxSpanColumns];          ///< width_q / (yr - yl), 0 when flat
   alignas(64) std::int32_t base_row[3][kMaxSpanColumns];  ///< floor(min(yl, yr))
 };
 
 /// Computes coverage for columns [col, col + kColumnGroup) of `columns` and rows
 /// [row_begin, row_end), writing 8.8 values to out[(r - row_begin) * stride + (c - col)].
 /// `sign` is +1 or -1 as above.
-using CoverageRowsFn = void (*)(const CoverageColumns& columns, int col, int row_begin,
-                                int row_end, int sign, std::uint16_t* out, std::size_t stride);
+using CoverageRowsFn = void (*)(const CoverageColumns& columns, int col, int row_begin, int row_end,
+                                int sign, std::uint16_t* out, std::size_t stride);
 
 /// The scalar twin: the same operations in the same order, one column at a time.
 void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin, int row_end,
@@ -98,5 +98,21 @@ struct ColumnRows {
 
 /// Fills lane `lane` of `columns` for absolute column `col` and returns its rows.
 ColumnRows setup_column(const CoverageTriangle& tri, int col, CoverageColumns& columns, int lane);
+
+/// Rows of one group of columns, clipped: the kernel runs on [first, interior_begin) and
+/// [interior_end, end); the rows between are the interior run (the long edge's width_q).
+struct GroupRows {
+  int first;
+  int end;
+  int interior_begin;
+  int interior_end;
+  bool empty() const { return first >= end; }
+};
+
+/// Sets up columns [col, col + kColumnGroup) of `tri` in `columns` (lanes from `lanes` on
+/// get zero width, so the kernel writes 0 there) and returns the group's rows clipped to
+/// [row_min, row_max). The one set-up loop of the coverage mode, its tests and benchmarks.
+GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                             int row_max, CoverageColumns& columns);
 
 }  // namespace covrast::detail

@@ -85,6 +85,32 @@ ColumnRows setup_column(const CoverageTriangle& tri, int col, CoverageColumns& c
   return rows;
 }
 
+GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                             int row_max, CoverageColumns& columns) {
+  int first = INT_MAX, end = INT_MIN, interior_begin = INT_MIN, interior_end = INT_MAX;
+  for (int lane = 0; lane < kColumnGroup; ++lane) {
+    if (lane >= lanes) {
+      for (int e = 0; e < 3; ++e) {
+        columns.t_left[e][lane] = columns.t_right[e][lane] = 0.0f;
+        columns.width_q[e][lane] = columns.slope_q[e][lane] = 0.0f;
+        columns.base_row[e][lane] = 0;
+      }
+      continue;
+    }
+    const ColumnRows rows = setup_column(tri, col + lane, columns, lane);
+    if (rows.first >= rows.end) continue;
+    first = std::min(first, rows.first);
+    end = std::max(end, rows.end);
+    interior_begin = std::max(interior_begin, rows.interior_begin);
+    interior_end = std::min(interior_end, rows.interior_end);
+  }
+  GroupRows g{std::max(first, row_min), std::min(end, row_max), 0, 0};
+  if (g.empty()) return GroupRows{0, 0, 0, 0};
+  g.interior_begin = std::clamp(interior_begin, g.first, g.end);
+  g.interior_end = std::clamp(interior_end, g.interior_begin, g.end);
+  return g;
+}
+
 void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin, int row_end,
                           int sign, std::uint16_t* out, std::size_t stride) {
   for (int r = row_begin; r < row_end; ++r, out += stride) {
@@ -95,8 +121,8 @@ void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin
         const float a = columns.t_left[e][c] - k;
         const float b = columns.t_right[e][c] - k;
         const float lo = std::min(a, b), hi = std::max(a, b);
-        const bool simple = hi <= 0.0f || lo >= 1.0f || (lo >= 0.0f && hi <= 1.0f) ||
-                            (hi - lo) < kFlatEdgeEps;
+        const bool simple =
+            hi <= 0.0f || lo >= 1.0f || (lo >= 0.0f && hi <= 1.0f) || (hi - lo) < kFlatEdgeEps;
         const float mid = std::min(std::max((a + b) * 0.5f, 0.0f), 1.0f);
         const float ca = std::min(std::max(a, 0.0f), 1.0f);
         const float cb = std::min(std::max(b, 0.0f), 1.0f);
