@@ -38,18 +38,18 @@ void CoverageRows(const CoverageColumns& columns, int col, int row_begin, int ro
         const auto b = hn::Sub(hn::LoadU(df, &columns.t_right[e][c]), k);
         const auto lo = hn::Min(a, b);
         const auto hi = hn::Max(a, b);
-        const auto simple =
-            hn::Or(hn::Or(hn::Le(hi, zero), hn::Ge(lo, one)),
-                   hn::Or(hn::And(hn::Ge(lo, zero), hn::Le(hi, one)), hn::Lt(hn::Sub(hi, lo), eps)));
+        const auto simple = hn::Or(
+            hn::Or(hn::Le(hi, zero), hn::Ge(lo, one)),
+            hn::Or(hn::And(hn::Ge(lo, zero), hn::Le(hi, one)), hn::Lt(hn::Sub(hi, lo), eps)));
         const auto mid = hn::Min(hn::Max(hn::Mul(hn::Add(a, b), half), zero), one);
         const auto ca = hn::Min(hn::Max(a, zero), one);
         const auto cb = hn::Min(hn::Max(b, zero), one);
         // H(t) = clamp(t, 0, 1)^2 / 2 + max(t - 1, 0)
         const auto ha = hn::Add(hn::Mul(hn::Mul(ca, ca), half), hn::Max(hn::Sub(a, one), zero));
         const auto hb = hn::Add(hn::Mul(hn::Mul(cb, cb), half), hn::Max(hn::Sub(b, one), zero));
-        const auto area = hn::IfThenElse(
-            simple, hn::Mul(hn::LoadU(df, &columns.width_q[e][c]), mid),
-            hn::Mul(hn::Sub(hb, ha), hn::LoadU(df, &columns.slope_q[e][c])));
+        const auto area =
+            hn::IfThenElse(simple, hn::Mul(hn::LoadU(df, &columns.width_q[e][c]), mid),
+                           hn::Mul(hn::Sub(hb, ha), hn::LoadU(df, &columns.slope_q[e][c])));
         q[e] = hn::NearestInt(area);
       }
       auto cov = hn::Sub(hn::Sub(q[0], q[1]), q[2]);
