@@ -18,6 +18,7 @@
 #include <catch2/catch.hpp>
 
 #include "resolve/abuffer.hpp"
+#include "test_meshes.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -40,6 +41,8 @@ using covrast::RenderOptions;
 using covrast::Scene;
 using covrast::detail::kSubpixelOne;
 using covrast::detail::TriangleSetup;
+using covrast::test::add_instance;
+using covrast::test::uv_sphere;
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kEyeZ = 10.0;
@@ -93,46 +96,6 @@ std::shared_ptr<MeshData> screen_mesh(const Scene& s, const std::vector<ScreenVe
     m->indices.push_back(std::uint32_t(i));
   }
   m->colors_linear = colors;
-  return m;
-}
-
-void add_instance(Scene& s, std::shared_ptr<const MeshData> mesh, glm::vec3 color,
-                  ColorSource source = ColorSource::Uniform) {
-  MeshInstance inst;
-  inst.mesh = std::move(mesh);
-  inst.color_source = source;
-  inst.color_linear = color;
-  s.meshes.push_back(inst);
-}
-
-/// UV sphere of radius 1 at the origin (poles on y), triangles outward counter-clockwise.
-std::shared_ptr<MeshData> uv_sphere(int stacks, int slices) {
-  auto m = std::make_shared<MeshData>();
-  m->source = "uv sphere";
-  m->positions.push_back(glm::vec3(0, 1, 0));
-  for (int i = 1; i < stacks; ++i) {
-    const double theta = kPi * i / stacks;
-    for (int j = 0; j < slices; ++j) {
-      const double phi = 2 * kPi * j / slices;
-      m->positions.push_back(glm::vec3(float(std::sin(theta) * std::cos(phi)),
-                                       float(std::cos(theta)),
-                                       float(-std::sin(theta) * std::sin(phi))));
-    }
-  }
-  m->positions.push_back(glm::vec3(0, -1, 0));
-  const std::uint32_t south = std::uint32_t(m->positions.size() - 1);
-  auto ring = [&](int i, int j) { return std::uint32_t(1 + (i - 1) * slices + (j % slices)); };
-  auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-    m->indices.insert(m->indices.end(), {a, b, c});
-  };
-  for (int j = 0; j < slices; ++j) tri(0, ring(1, j), ring(1, j + 1));
-  for (int i = 1; i + 1 < stacks; ++i) {
-    for (int j = 0; j < slices; ++j) {
-      tri(ring(i, j), ring(i + 1, j), ring(i + 1, j + 1));
-      tri(ring(i, j), ring(i + 1, j + 1), ring(i, j + 1));
-    }
-  }
-  for (int j = 0; j < slices; ++j) tri(ring(stacks - 1, j), south, ring(stacks - 1, j + 1));
   return m;
 }
 

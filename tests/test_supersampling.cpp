@@ -10,6 +10,7 @@
 #include "raster/sample_pattern.hpp"
 #include "raster/sample_raster.hpp"
 #include "resolve/srgb8.hpp"
+#include "test_meshes.hpp"
 
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -44,6 +45,8 @@ using covrast::detail::SamplePattern;
 using covrast::detail::SampleRasterizer;
 using covrast::detail::ShadingRate;
 using covrast::detail::TriangleSetup;
+using covrast::test::add_instance;
+using covrast::test::uv_sphere;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -558,46 +561,6 @@ Scene base_scene(int width, int height, glm::vec3 background) {
   return s;
 }
 
-void add_mesh(Scene& s, std::shared_ptr<MeshData> mesh, ColorSource source, glm::vec3 color) {
-  MeshInstance inst;
-  inst.mesh = std::move(mesh);
-  inst.color_source = source;
-  inst.color_linear = color;
-  s.meshes.push_back(inst);
-}
-
-/// Closed UV sphere of radius 1: single-vertex poles with triangle fans, and the seam
-/// reuses segment 0, so every edge is shared by exactly two triangles.
-std::shared_ptr<MeshData> uv_sphere(int segments, int rings) {
-  auto m = std::make_shared<MeshData>();
-  m->source = "uv sphere";
-  m->positions.push_back(glm::vec3(0, 1, 0));
-  for (int r = 1; r < rings; ++r) {
-    const double theta = kPi * r / rings;
-    for (int s = 0; s < segments; ++s) {
-      const double phi = 2 * kPi * s / segments;
-      m->positions.push_back(glm::vec3(float(std::sin(theta) * std::cos(phi)),
-                                       float(std::cos(theta)),
-                                       float(-std::sin(theta) * std::sin(phi))));
-    }
-  }
-  m->positions.push_back(glm::vec3(0, -1, 0));
-  const std::uint32_t south = std::uint32_t(m->positions.size() - 1);
-  auto ring = [&](int r, int s) { return std::uint32_t(1 + (r - 1) * segments + s % segments); };
-  auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
-    m->indices.insert(m->indices.end(), {a, b, c});
-  };
-  for (int s = 0; s < segments; ++s) tri(0, ring(1, s), ring(1, s + 1));
-  for (int r = 1; r + 1 < rings; ++r) {
-    for (int s = 0; s < segments; ++s) {
-      tri(ring(r, s), ring(r + 1, s), ring(r + 1, s + 1));
-      tri(ring(r, s), ring(r + 1, s + 1), ring(r, s + 1));
-    }
-  }
-  for (int s = 0; s < segments; ++s) tri(ring(rings - 1, s), south, ring(rings - 1, s + 1));
-  return m;
-}
-
 covrast::RenderResult render_mode(const Scene& s, const std::string& mode, int threads = 1,
                                   int tile = 64) {
   RenderOptions o;
@@ -615,7 +578,7 @@ TEST_CASE("seam scene: a closed sphere in the background colour renders exactly 
   s.camera.eye = glm::dvec3(0.7, 2.6, 1.6);  // the north pole fan and the phi = 0 seam in view
   s.camera.fovy_deg = 50;
   s.camera.near = 0.5;
-  add_mesh(s, uv_sphere(32, 16), ColorSource::Uniform, background);
+  add_instance(s, uv_sphere(16, 32), background);
   // The sphere is really there: in white it covers a good part of the image.
   Scene white = s;
   white.meshes[0].color_linear = glm::vec3(1.0f);
@@ -777,8 +740,8 @@ Scene determinism_scene(int width, int height) {
     }
     soup->indices.push_back(i);
   }
-  add_mesh(s, soup, ColorSource::Vertex, glm::vec3(1.0f));
-  add_mesh(s, soup, ColorSource::Uniform, glm::vec3(0.9f, 0.5f, 0.2f));
+  add_instance(s, soup, glm::vec3(1.0f), ColorSource::Vertex);
+  add_instance(s, soup, glm::vec3(0.9f, 0.5f, 0.2f));
   s.meshes.back().model = glm::dmat4(1.0);
   s.meshes.back().model[3] = glm::dvec4(0.3, -0.2, -1.5, 1.0);
   auto floor = std::make_shared<MeshData>();
@@ -786,7 +749,7 @@ Scene determinism_scene(int width, int height) {
   floor->positions = {glm::vec3(-20000, -1.5f, -60), glm::vec3(20000, -1.5f, -60),
                       glm::vec3(0, -1.5f, 8)};
   floor->indices = {0, 1, 2};
-  add_mesh(s, floor, ColorSource::Uniform, glm::vec3(0.3f, 0.6f, 0.3f));
+  add_instance(s, floor, glm::vec3(0.3f, 0.6f, 0.3f));
   return s;
 }
 

@@ -1,0 +1,57 @@
+// Small meshes and scene helpers shared by the test files (test-only code).
+#pragma once
+
+#include <covrast/scene.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <numbers>
+
+namespace covrast::test {
+
+/// Closed UV sphere of radius 1 at the origin, poles on y: `rings` bands from pole to pole,
+/// `segments` around. Single-vertex poles with triangle fans, and the seam reuses segment 0,
+/// so every edge is shared by exactly two triangles; outward faces counter-clockwise.
+inline std::shared_ptr<MeshData> uv_sphere(int rings, int segments) {
+  constexpr double kPi = std::numbers::pi;
+  auto m = std::make_shared<MeshData>();
+  m->source = "uv sphere";
+  m->positions.push_back(glm::vec3(0, 1, 0));
+  for (int r = 1; r < rings; ++r) {
+    const double theta = kPi * r / rings;
+    for (int s = 0; s < segments; ++s) {
+      const double phi = 2 * kPi * s / segments;
+      m->positions.push_back(glm::vec3(float(std::sin(theta) * std::cos(phi)),
+                                       float(std::cos(theta)),
+                                       float(-std::sin(theta) * std::sin(phi))));
+    }
+  }
+  m->positions.push_back(glm::vec3(0, -1, 0));
+  const std::uint32_t south = std::uint32_t(m->positions.size() - 1);
+  auto ring = [&](int r, int s) { return std::uint32_t(1 + (r - 1) * segments + s % segments); };
+  auto tri = [&](std::uint32_t a, std::uint32_t b, std::uint32_t c) {
+    m->indices.insert(m->indices.end(), {a, b, c});
+  };
+  for (int s = 0; s < segments; ++s) tri(0, ring(1, s), ring(1, s + 1));
+  for (int r = 1; r + 1 < rings; ++r) {
+    for (int s = 0; s < segments; ++s) {
+      tri(ring(r, s), ring(r + 1, s), ring(r + 1, s + 1));
+      tri(ring(r, s), ring(r + 1, s + 1), ring(r, s + 1));
+    }
+  }
+  for (int s = 0; s < segments; ++s) tri(ring(rings - 1, s), south, ring(rings - 1, s + 1));
+  return m;
+}
+
+/// Appends an instance of `mesh` (identity model matrix) to the scene.
+inline void add_instance(Scene& scene, std::shared_ptr<const MeshData> mesh, glm::vec3 color,
+                         ColorSource source = ColorSource::Uniform) {
+  MeshInstance instance;
+  instance.mesh = std::move(mesh);
+  instance.color_source = source;
+  instance.color_linear = color;
+  scene.meshes.push_back(instance);
+}
+
+}  // namespace covrast::test
