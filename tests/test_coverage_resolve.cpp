@@ -858,3 +858,75 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
        << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
   CHECK(targets.size() >= 1);
 }
+
+TEST_CASE("coverage resolve: the whole-tile path gives what pixel-by-pixel adds give",
+          "[coverage]") {
+  using covrast::detail::ABufferTile;
+  using covrast::detail::FrameTarget;
+  using covrast::detail::kCoverageOne;
+  using covrast::detail::PixelRect;
+  constexpr int kTile = 32;
+  const PixelRect rect{64, 96, 64 + kTile, 96 + kTile};
+  const double cx = 0.5 * (rect.x0 + rect.x1), cy = 0.5 * (rect.y0 + rect.y1);
+  std::mt19937 rng(2024);
+  std::uniform_real_distribution<double> centre(0.3, 0.7);
+  const double slopes[] = {0.0, 1e-15, -1e-15, 1e-4, -1e-4, 1e-3, -2e-3};
+  int decided = 0, undecided = 0;
+  for (int round = 0; round < 300; ++round) {
+    const int n = 2 + int(rng() % 4);
+    std::vector<TriangleSetup> tris(std::size_t(n), TriangleSetup{});
+    for (int k = 0; k < n; ++k) {
+      TriangleSetup& t = tris[std::size_t(k)];
+      // A large triangle around the tile (positive doubled area, y down).
+      const std::int32_t lo = -1000 * kSubpixelOne, hi = 3000 * kSubpixelOne;
+      t.x_fx8[0] = lo, t.y_fx8[0] = lo;
+      t.x_fx8[1] = hi, t.y_fx8[1] = lo;
+      t.x_fx8[2] = lo, t.y_fx8[2] = hi;
+      t.dzdx = slopes[rng() % std::size(slopes)];
+      t.dzdy = slopes[rng() % std::size(slopes)];
+      double zc = centre(rng);
+      if (k > 0 && rng() % 3 == 0) {
+        // A tie or near tie with the previous plane.
+        const TriangleSetup& p = tris[std::size_t(k - 1)];
+        t.dzdx = p.dzdx;
+        t.dzdy = p.dzdy;
+        zc = p.depth_at(cx, cy) + (rng() % 2 == 0 ? 0.0 : 1e-11);
+      }
+      t.z0 = zc - t.dzdx * (cx + 1000.0) - t.dzdy * (cy + 1000.0);
+      t.inv_w[0] = t.inv_w[1] = t.inv_w[2] = 1.0f;
+      t.color[0] = t.color[1] = t.color[2] = from_codes(40 * k + 20, 200 - 30 * k, 90 + 25 * k);
+      t.primitive = std::uint32_t(k);
+      t.surface = std::uint32_t(k);
+      t.front_facing = true;
+      t.flat_color = true;
+    }
+    Image image[2];
+    covrast::DepthImage depth[2];
+    for (int path = 0; path < 2; ++path) {
+      image[path].width = depth[path].width = rect.x1;
+      image[path].height = depth[path].height = rect.y1;
+      image[path].rgb.assign(std::size_t(rect.x1) * rect.y1 * 3, 0);
+      depth[path].depth.assign(std::size_t(rect.x1) * rect.y1, -1.0f);
+      ABufferTile abuffer(kTile);
+      abuffer.begin_tile(rect);
+      for (const TriangleSetup& t : tris) {
+        if (path == 0) {
+          if (abuffer.add_covering_tile(&t)) {
+            ++decided;
+            continue;
+          }
+          ++undecided;
+        }
+        for (int y = rect.y0; y < rect.y1; ++y) {
+          for (int x = rect.x0; x < rect.x1; ++x) abuffer.add(x, y, &t, kCoverageOne);
+        }
+      }
+      abuffer.resolve(FrameTarget{&image[path], &depth[path], from_codes(0, 0, 255)});
+    }
+    REQUIRE(image[0].rgb == image[1].rgb);
+    REQUIRE(depth[0].depth == depth[1].depth);
+  }
+  // Both branches ran many times: the fast path decided some tiles and left others.
+  CHECK(decided > 300);
+  CHECK(undecided > 100);
+}

@@ -6,6 +6,7 @@
 //  - coverage-blend: the literal seed, alpha-blended over the frame buffer with one depth
 //                    per pixel (kept to show what the A-buffer fixes).
 #include "raster/coverage_kernel.hpp"
+#include "raster/edge_function.hpp"
 #include "raster/shading.hpp"
 #include "raster/tile_raster.hpp"
 #include "resolve/abuffer.hpp"
@@ -49,6 +50,7 @@ class CoverageRasterizer final : public TileRasterizer {
   void draw(const TriangleSetup& t) override {
     const PixelRect r = intersect(touched_pixels(t), rect_);
     if (r.empty()) return;
+    if (!blend_ && covers_tile(t) && abuffer_.add_covering_tile(&t)) return;
     const CoverageTriangle tri = make_coverage_triangle(t);
     CoverageColumns& cols = *columns_;
     for (int g = r.x0; g < r.x1; g += kColumnGroup) {
@@ -93,6 +95,24 @@ class CoverageRasterizer final : public TileRasterizer {
   CoverageRowsFn kernel_ = coverage_rows_simd;
 
  private:
+  /// Whether the triangle covers every pixel of the tile completely: all four corners of
+  /// the tile rectangle are inside or on each edge (the triangle is convex), exact in int64.
+  bool covers_tile(const TriangleSetup& t) const {
+    const TriangleEdges edges(t);
+    const std::int64_t xs[2] = {std::int64_t(rect_.x0) * kSubpixelOne,
+                                std::int64_t(rect_.x1) * kSubpixelOne};
+    const std::int64_t ys[2] = {std::int64_t(rect_.y0) * kSubpixelOne,
+                                std::int64_t(rect_.y1) * kSubpixelOne};
+    for (const EdgeFunction& e : edges.e) {
+      for (std::int64_t y : ys) {
+        for (std::int64_t x : xs) {
+          if (e.at(x, y) - e.bias < 0) return false;  // E without the top-left bias
+        }
+      }
+    }
+    return true;
+  }
+
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
   void consume(const TriangleSetup& t, int g, int lanes, int first, int end) {
     for (int y = first; y < end; ++y) {

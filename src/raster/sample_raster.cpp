@@ -24,16 +24,8 @@ std::uint32_t quantize_color(float linear) {
   return std::uint32_t(double(linear) * kColorOne + 0.5);
 }
 
-SampleRasterizer::SampleRasterizer(int tile_px, const SamplePattern& pattern, ShadingRate rate,
-                                   const SampleKernels& kernels, std::size_t band_budget_bytes)
-    : tile_px_(tile_px),
-      rate_(rate),
-      kernels_(kernels),
-      pattern_(std::make_unique<GroupPattern>()),
-      tri_(std::make_unique<GroupTriangle>()),
-      pixel_pattern_(pattern) {
+void make_group_pattern(const SamplePattern& pattern, GroupPattern& gp) {
   const int s = pattern.size();
-  GroupPattern& gp = *pattern_;
   // P = S when S divides 16 (G = 16 / S pixels share a group), else S rounded up to 16.
   gp.samples = s;
   gp.stride = kGroupLaneBlock % s == 0 ? s : round_up(s, kGroupLaneBlock);
@@ -58,6 +50,59 @@ SampleRasterizer::SampleRasterizer(int tile_px, const SamplePattern& pattern, Sh
       gp.oy_max = std::max(gp.oy_max, oy);
     }
   }
+}
+
+bool make_raster_job(const GroupPattern& gp, const TriangleSetup& t, const PixelRect& r,
+                     RasterJob& job) {
+  const int group_px = gp.group_px;
+  const TriangleEdges edges(t);
+  // Group extent X = G * 256 [fx8]; see sample_kernel.hpp for the int32 bound.
+  const std::int64_t extent = std::int64_t(group_px) * kSubpixelOne;
+  bool fits = true;
+  const int gx0 = floor_div(r.x0, group_px) * group_px;
+  for (int e = 0; e < 3; ++e) {
+    const EdgeFunction& ef = edges.e[e];
+    if ((std::abs(ef.dx) + std::abs(ef.dy)) * extent >= kEdgeClamp) fits = false;
+    // Extremes of c = dx * oy - dy * ox over the box of the pattern's offsets.
+    const std::int64_t a0 = ef.dx * gp.oy_min, a1 = ef.dx * gp.oy_max;
+    const std::int64_t b0 = -ef.dy * gp.ox_min, b1 = -ef.dy * gp.ox_max;
+    job.c_min[e] = std::min(a0, a1) + std::min(b0, b1);
+    job.c_max[e] = std::max(a0, a1) + std::max(b0, b1);
+    job.step_x[e] = ef.step_x(extent);
+    job.step_y[e] = ef.step_y(kSubpixelOne);
+    job.f[e] = ef.at(std::int64_t(gx0) * kSubpixelOne, std::int64_t(r.y0) * kSubpixelOne);
+  }
+  for (int e = 0; e < 3; ++e) {
+    job.dx[e] = fits ? std::int32_t(edges.e[e].dx) : 0;
+    job.dy[e] = fits ? std::int32_t(edges.e[e].dy) : 0;
+  }
+  job.gx0 = gx0;
+  job.y0 = r.y0;
+  job.groups = (r.x1 - gx0 + group_px - 1) / group_px;
+  job.rows = r.y1 - r.y0;
+  job.dzdx_f = float(t.dzdx);
+  job.dzdy_f = float(t.dzdy);
+  job.z0 = t.z0;
+  job.dzdx = t.dzdx;
+  job.dzdy = t.dzdy;
+  job.vx = t.x_fx8[0] * (1.0 / kSubpixelOne);
+  job.vy = t.y_fx8[0] * (1.0 / kSubpixelOne);
+  job.rgb = nullptr;
+  job.shade_fn = nullptr;
+  job.shade_context = nullptr;
+  return fits;
+}
+
+SampleRasterizer::SampleRasterizer(int tile_px, const SamplePattern& pattern, ShadingRate rate,
+                                   const SampleKernels& kernels, std::size_t band_budget_bytes)
+    : tile_px_(tile_px),
+      rate_(rate),
+      kernels_(kernels),
+      pattern_(std::make_unique<GroupPattern>()),
+      tri_(std::make_unique<GroupTriangle>()),
+      pixel_pattern_(pattern) {
+  make_group_pattern(pattern, *pattern_);
+  const GroupPattern& gp = *pattern_;
   // A tile's groups run from rect.x0 rounded down to G to rect.x1 rounded up to G.
   buffer_px_ = gp.group_px == 1 ? tile_px : round_up(tile_px, gp.group_px) + gp.group_px;
   row_lanes_ = std::size_t(buffer_px_) * std::size_t(gp.stride);
@@ -160,31 +205,9 @@ void SampleRasterizer::start_band(int y0, int y1) {
 void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
   const GroupPattern& gp = *pattern_;
   const int group_px = gp.group_px;
-  const TriangleEdges edges(t);
-  // Group extent X = G * 256 [fx8]; see sample_kernel.hpp for the int32 bound.
-  const std::int64_t extent = std::int64_t(group_px) * kSubpixelOne;
-  bool fits = true;
-  std::int64_t c_min[3], c_max[3], step_x[3], step_y[3], f_row[3];
-  std::int32_t dx32[3] = {0, 0, 0}, dy32[3] = {0, 0, 0};
-  const int gx0 = floor_div(r.x0, group_px) * group_px;
-  for (int e = 0; e < 3; ++e) {
-    const EdgeFunction& ef = edges.e[e];
-    if ((std::abs(ef.dx) + std::abs(ef.dy)) * extent >= kEdgeClamp) fits = false;
-    // Extremes of c = dx * oy - dy * ox over the box of the pattern's offsets.
-    const std::int64_t a0 = ef.dx * gp.oy_min, a1 = ef.dx * gp.oy_max;
-    const std::int64_t b0 = -ef.dy * gp.ox_min, b1 = -ef.dy * gp.ox_max;
-    c_min[e] = std::min(a0, a1) + std::min(b0, b1);
-    c_max[e] = std::max(a0, a1) + std::max(b0, b1);
-    step_x[e] = ef.step_x(extent);
-    step_y[e] = ef.step_y(kSubpixelOne);
-    f_row[e] = ef.at(std::int64_t(gx0) * kSubpixelOne, std::int64_t(r.y0) * kSubpixelOne);
-  }
-  if (fits) {
-    for (int e = 0; e < 3; ++e) {
-      dx32[e] = std::int32_t(edges.e[e].dx);
-      dy32[e] = std::int32_t(edges.e[e].dy);
-    }
-  }
+  RasterJob job;
+  const bool fits = make_raster_job(gp, t, r, job);
+  const int gx0 = job.gx0;
   std::uint32_t rgb[3];
   const std::uint32_t* flat_rgb = nullptr;
   if (t.flat_color) {
@@ -195,27 +218,6 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
   }
   const std::size_t stride = std::size_t(gp.stride);
   if (fits) {
-    RasterJob job;
-    job.gx0 = gx0;
-    job.y0 = r.y0;
-    job.groups = (r.x1 - gx0 + group_px - 1) / group_px;
-    job.rows = r.y1 - r.y0;
-    for (int e = 0; e < 3; ++e) {
-      job.f[e] = f_row[e];
-      job.step_x[e] = step_x[e];
-      job.step_y[e] = step_y[e];
-      job.c_min[e] = c_min[e];
-      job.c_max[e] = c_max[e];
-      job.dx[e] = dx32[e];
-      job.dy[e] = dy32[e];
-    }
-    job.dzdx_f = float(t.dzdx);
-    job.dzdy_f = float(t.dzdy);
-    job.z0 = t.z0;
-    job.dzdx = t.dzdx;
-    job.dzdy = t.dzdy;
-    job.vx = t.x_fx8[0] * (1.0 / kSubpixelOne);
-    job.vy = t.y_fx8[0] * (1.0 / kSubpixelOne);
     job.rgb = flat_rgb;
     ShadeContext context{this, &t};
     job.shade_fn = &SampleRasterizer::shade_trampoline;
@@ -232,6 +234,7 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
   // An edge too long for int32 lanes: classify here, and test partly covered groups with
   // int64 arithmetic (sample_wide).
   bool set_up = false;
+  std::int64_t f_row[3] = {job.f[0], job.f[1], job.f[2]};
   for (int y = r.y0; y < r.y1; ++y) {
     std::int64_t f[3] = {f_row[0], f_row[1], f_row[2]};
     std::size_t lane =
@@ -240,14 +243,14 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
     for (int gx = gx0; gx < r.x1; gx += group_px, lane += std::size_t(gp.lanes)) {
       bool all_inside = true, none = false;
       for (int e = 0; e < 3; ++e) {
-        none |= f[e] + c_max[e] < 0;
-        all_inside &= f[e] + c_min[e] >= 0;
+        none |= f[e] + job.c_max[e] < 0;
+        all_inside &= f[e] + job.c_min[e] >= 0;
       }
       const std::int64_t f_here[3] = {f[0], f[1], f[2]};
-      for (int e = 0; e < 3; ++e) f[e] += step_x[e];
+      for (int e = 0; e < 3; ++e) f[e] += job.step_x[e];
       if (none) continue;
       if (!set_up) {
-        kernels_.setup(gp, dx32, dy32, false, float(t.dzdx), float(t.dzdy), *tri_);
+        kernels_.setup(gp, job.dx, job.dy, false, job.dzdx_f, job.dzdy_f, *tri_);
         set_up = true;
       }
       const float z_base = float(t.depth_at(gx, y));
@@ -265,7 +268,7 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
       }
       if (any && flat_rgb == nullptr) shade_written(t, gx, y, written, out);
     }
-    for (int e = 0; e < 3; ++e) f_row[e] += step_y[e];
+    for (int e = 0; e < 3; ++e) f_row[e] += job.step_y[e];
   }
 }
 

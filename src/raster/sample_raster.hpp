@@ -101,6 +101,17 @@ class SampleRasterizer final : public TileRasterizer {
   std::uint32_t background_q_[3] = {0, 0, 0};
 };
 
+/// The group layout of a pixel pattern: P = S when S divides 16 (G = 16 / S pixels share a
+/// group), else S rounded up to 16 (G = 1); padding lanes have offset 0 and valid 0.
+void make_group_pattern(const SamplePattern& pattern, GroupPattern& out);
+
+/// The per-triangle part of the RasterJob for pixels `r` (groups from x = floor(r.x0 / G) * G,
+/// rows from r.y0): edge values, steps and bounds, depth plane. Returns false when an edge is
+/// too long for the int32 lanes (dx and dy are then 0). rgb, shade_fn, shade_context, first
+/// and row_lanes are left to the caller.
+bool make_raster_job(const GroupPattern& gp, const TriangleSetup& t, const PixelRect& r,
+                     RasterJob& job);
+
 /// Fixed-point linear colour of sample_kernel.hpp: round(clamp(c, 0, 1) * 2^22).
 std::uint32_t quantize_color(float linear);
 

@@ -36,21 +36,6 @@ DepthRange depth_range(const TriangleSetup& t, int x, int y) {
   return {c.min(), c.max()};
 }
 
-/// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
-/// difference is extreme at the corners: nearer at all four corners is in front; farther or
-/// equal at all four is behind (equal depth keeps the earlier triangle); else they cross.
-
-DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y) {
-  CornerDepths a = corner_depths(t, x, y), b = corner_depths(other, x, y);
-  if (a.max() < b.min()) return DepthOrder::InFront;
-  if (a.min() >= b.max()) return DepthOrder::Behind;
-  int nearer = 0;
-  for (int k = 0; k < 4; ++k) nearer += a.z[k] < b.z[k];
-  if (nearer == 4) return DepthOrder::InFront;
-  if (nearer == 0) return DepthOrder::Behind;
-  return DepthOrder::Crossing;
-}
-
 bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
   return a.surface == b.surface && a.front_facing == b.front_facing;
 }
@@ -96,6 +81,21 @@ std::uint64_t sample_mask(const TriangleSetup& t, int x, int y) {
 
 }  // namespace
 
+/// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
+/// difference is extreme at the corners: nearer at all four corners is in front; farther or
+/// equal at all four is behind (equal depth keeps the earlier triangle); else they cross.
+
+DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y) {
+  CornerDepths a = corner_depths(t, x, y), b = corner_depths(other, x, y);
+  if (a.max() < b.min()) return DepthOrder::InFront;
+  if (a.min() >= b.max()) return DepthOrder::Behind;
+  int nearer = 0;
+  for (int k = 0; k < 4; ++k) nearer += a.z[k] < b.z[k];
+  if (nearer == 4) return DepthOrder::InFront;
+  if (nearer == 0) return DepthOrder::Behind;
+  return DepthOrder::Crossing;
+}
+
 ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
   std::size_t n = std::size_t(tile_px) * tile_px;
   opaque_.resize(n);
@@ -109,70 +109,75 @@ ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
 
 void ABufferTile::begin_tile(const PixelRect& rect) {
   rect_ = rect;
-  std::fill(opaque_.begin(), opaque_.end(), nullptr);
+  uniform_valid_ = true;
+  uniform_ = nullptr;
   std::fill(head_.begin(), head_.end(), kEnd);
   std::fill(count_.begin(), count_.end(), 0);
   pool_.clear();
+  merged_slot_.clear();
+  merged_.clear();
 }
 
-/// order_of, decided in most cases from the planes' difference at the pixel centre and a
-/// bound on how far it can move towards a corner: |d(corner) - d(centre)| <=
-/// (|ddz/dx| + |ddz/dy|) / 2. Near ties it falls back to the exact corner comparison.
-DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, double t_centre_z,
-                                             std::size_t pixel, int x, int y) const {
-  const TriangleSetup& o = *opaque_[pixel];
-  const double d = t_centre_z - opaque_z_[pixel];
-  const double reach = 0.5 * (std::fabs(t.dzdx - o.dzdx) + std::fabs(t.dzdy - o.dzdy));
-  constexpr double kMargin = 1e-12;  // far above the rounding of z in [0, 1]
-  if (d + reach < -kMargin) return DepthOrder::InFront;
-  if (d - reach > kMargin) return DepthOrder::Behind;
-  return order_of(t, o, x, y);
-}
-
-void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
-  const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-  const double centre_z = t->depth_at(x + 0.5, y + 0.5);
-  if (opaque_[pixel] == nullptr) {
-    if (coverage == std::uint32_t(kCoverageOne)) {
-      opaque_[pixel] = t;
-      opaque_z_[pixel] = centre_z;
-      return;
-    }
-  } else {
-    switch (order_against_opaque(*t, centre_z, pixel, x, y)) {
-      case DepthOrder::InFront:
-        // A fully covered pixel is an ordinary depth test.
-        if (coverage == std::uint32_t(kCoverageOne)) {
-          opaque_[pixel] = t;
-          opaque_z_[pixel] = centre_z;
-          return;
-        }
-        break;
-      case DepthOrder::Behind:
-        return;  // hidden everywhere in the pixel
-      case DepthOrder::Crossing:
-        break;  // kept as a fragment, resolved per sample
+void ABufferTile::materialize() {
+  uniform_valid_ = false;
+  for (int y = rect_.y0; y < rect_.y1; ++y) {
+    const std::size_t row = std::size_t(y - rect_.y0) * stride_;
+    for (int x = rect_.x0; x < rect_.x1; ++x) {
+      opaque_[row + (x - rect_.x0)] = uniform_;
+      // The centre depth exactly as add() computes it.
+      if (uniform_ != nullptr)
+        opaque_z_[row + (x - rect_.x0)] = uniform_->depth_at(x + 0.5, y + 0.5);
     }
   }
-  add_fragment(pixel, x, y, t, coverage);
 }
 
-void ABufferTile::merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask,
+bool ABufferTile::add_covering_tile(const TriangleSetup* t) {
+  if (!uniform_valid_) return false;
+  if (uniform_ == nullptr) {
+    uniform_ = t;
+    return true;
+  }
+  // The difference of the planes at the tile's corners bounds it at every pixel's corners.
+  // The margin is far above the rounding of the per-pixel tests, so whenever this decides,
+  // add() would have decided the same at every pixel.
+  constexpr double kTileMargin = 1e-9;
+  const double xs[2] = {double(rect_.x0), double(rect_.x1)};
+  const double ys[2] = {double(rect_.y0), double(rect_.y1)};
+  int nearer = 0, farther = 0;
+  for (double y : ys) {
+    for (double x : xs) {
+      const double d = t->depth_at(x, y) - uniform_->depth_at(x, y);
+      nearer += d < -kTileMargin;
+      farther += d > kTileMargin;
+    }
+  }
+  if (nearer == 4) {
+    uniform_ = t;
+    return true;
+  }
+  return farther == 4;  // hidden everywhere (equal depth would keep the earlier triangle)
+}
+
+void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, std::uint64_t mask,
                              glm::vec3 color, int x, int y) {
-  if (!f.merged) {
-    f.mask = sample_mask(*f.triangle, x, y);
-    f.color = shade(*f.triangle, x + 0.5, y + 0.5, true);
-    f.weight = f.coverage;
-    f.merged = true;
+  Fragment& fragment = pool_[f];
+  if (!(fragment.coverage & kMergedFlag)) {
+    if (merged_slot_.size() < pool_.size()) merged_slot_.resize(pool_.size(), kEnd);
+    merged_slot_[f] = std::uint32_t(merged_.size());
+    merged_.push_back(MergedPiece{sample_mask(*fragment.triangle, x, y),
+                                  shade(*fragment.triangle, x + 0.5, y + 0.5, true),
+                                  fragment.coverage});
   }
-  f.mask |= mask;
+  MergedPiece& m = merged_[merged_slot_[f]];
+  m.mask |= mask;
   // Running coverage-weighted mean of the pieces' colours.
-  const std::uint32_t weight = f.weight + coverage;
+  const std::uint32_t weight = m.weight + coverage;
   if (weight > 0) {
-    f.color = (f.color * float(f.weight) + color * float(coverage)) / float(weight);
+    m.color = (m.color * float(m.weight) + color * float(coverage)) / float(weight);
   }
-  f.weight = weight;
-  f.coverage = std::min<std::uint32_t>(f.coverage + coverage, kCoverageOne);
+  m.weight = weight;
+  const std::uint32_t sum = (fragment.coverage & ~kMergedFlag) + coverage;
+  fragment.coverage = kMergedFlag | std::min<std::uint32_t>(sum, kCoverageOne);
 }
 
 bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
@@ -210,8 +215,7 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     if (same == kEnd) same = f;
   }
   if (same != kEnd) {
-    merge_into(pool_[same], coverage, sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x,
-               y);
+    merge_into(same, coverage, sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x, y);
     return true;
   }
   // 3. Merge two fragments of one surface already in the list, freeing a slot.
@@ -219,26 +223,30 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     std::uint32_t prev = f;
     for (std::uint32_t g = pool_[f].next; g != kEnd; prev = g, g = pool_[g].next) {
       if (!same_surface(*pool_[f].triangle, *pool_[g].triangle)) continue;
-      Fragment& victim = pool_[g];
-      merge_into(pool_[f], victim.merged ? victim.weight : victim.coverage,
-                 victim.merged ? victim.mask : sample_mask(*victim.triangle, x, y),
-                 victim.merged ? victim.color : shade(*victim.triangle, x + 0.5, y + 0.5, true), x,
-                 y);
+      const Fragment victim = pool_[g];
+      if (victim.coverage & kMergedFlag) {
+        const MergedPiece piece = merged_piece(g);  // a copy: merge_into may grow merged_
+        merge_into(f, piece.weight, piece.mask, piece.color, x, y);
+      } else {
+        merge_into(f, victim.coverage, sample_mask(*victim.triangle, x, y),
+                   shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y);
+      }
       pool_[prev].next = victim.next;
       if (tail_[pixel] == g) tail_[pixel] = prev;
       --count_[pixel];
       return false;
     }
   }
-  // 4. Sixteen different surfaces in one pixel: keep the larger areas.
+  // 4. Many different surfaces in one pixel: keep the larger areas.
   std::uint32_t smallest = head_[pixel];
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    if (pool_[f].coverage < pool_[smallest].coverage) smallest = f;
+    if ((pool_[f].coverage & ~kMergedFlag) < (pool_[smallest].coverage & ~kMergedFlag)) {
+      smallest = f;
+    }
   }
-  if (coverage > pool_[smallest].coverage) {
+  if (coverage > (pool_[smallest].coverage & ~kMergedFlag)) {
     pool_[smallest].triangle = t;
     pool_[smallest].coverage = coverage;
-    pool_[smallest].merged = false;
   }
   return true;
 }
@@ -249,7 +257,7 @@ void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSe
     return;
   }
   std::uint32_t index = std::uint32_t(pool_.size());
-  pool_.push_back(Fragment{t, kEnd, coverage, 0, glm::vec3(0.0f), 0, false});
+  pool_.push_back(Fragment{t, kEnd, coverage});
   if (head_[pixel] == kEnd) {
     head_[pixel] = index;
   } else {
@@ -273,12 +281,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   const TriangleSetup* tri[kMaxFragmentsPerPixel];
   std::uint32_t cov[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
-  int group[kMaxFragmentsPerPixel];
-  // A group is one layer of one surface: fragments of the same mesh instance and facing,
-  // connected through shared vertices. Its pieces do not overlap, so their exact areas add.
-  std::uint64_t merged_mask[kMaxFragmentsPerPixel];
-  bool merged[kMaxFragmentsPerPixel];
-  glm::vec3 merged_color[kMaxFragmentsPerPixel];
+  const MergedPiece* merged[kMaxFragmentsPerPixel];  // null unless it stands for several
   int n = 0;
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
@@ -295,110 +298,57 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
       if (order == DepthOrder::Crossing) crossing = true;
     }
     tri[n] = t;
-    cov[n] = pool_[f].coverage;
+    const std::uint32_t c = pool_[f].coverage;
+    cov[n] = c & ~kMergedFlag;
+    merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
     range[n] = r;
-    merged[n] = pool_[f].merged;
-    merged_color[n] = pool_[f].color;
-    merged_mask[n] = pool_[f].mask;
     depth = std::min(depth, float(centre_z));
     ++n;
   }
   if (n == 0) return behind;
 
-  // Union-find over at most 16 fragments, then per-group sums and depth ranges.
-  int parent[kMaxFragmentsPerPixel];
-  for (int i = 0; i < n; ++i) parent[i] = i;
-  auto root = [&](int i) {
-    while (parent[i] != i) i = parent[i] = parent[parent[i]];
-    return i;
+  // The front layer: the fragment nearest at its nearest point and every fragment
+  // connected to it (same mesh instance and facing, through shared vertices; a merged
+  // fragment already stands for adjacent pieces of its surface). Its pieces do not
+  // overlap, so their exact areas add.
+  auto connected = [&](int i, int j) {
+    return same_surface(*tri[i], *tri[j]) &&
+           (merged[i] != nullptr || merged[j] != nullptr || share_vertex(*tri[i], *tri[j]));
   };
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      // A merged fragment already stands for adjacent pieces of its surface.
-      if (same_surface(*tri[i], *tri[j]) &&
-          (merged[i] || merged[j] || share_vertex(*tri[i], *tri[j]))) {
-        parent[root(j)] = root(i);
-      }
+  int nearest = 0;
+  for (int i = 1; i < n; ++i) {
+    if (range[i].min < range[nearest].min) nearest = i;
+  }
+  bool in_front[kMaxFragmentsPerPixel] = {};
+  int stack[kMaxFragmentsPerPixel];
+  int top = 0, members = 1;
+  in_front[nearest] = true;
+  stack[top++] = nearest;
+  std::uint32_t front_coverage = cov[nearest];
+  double front_max = range[nearest].max;
+  while (top > 0) {
+    const int m = stack[--top];
+    for (int j = 0; j < n; ++j) {
+      if (in_front[j] || !connected(m, j)) continue;
+      in_front[j] = true;
+      stack[top++] = j;
+      ++members;
+      front_coverage += cov[j];
+      front_max = std::max(front_max, range[j].max);
     }
   }
-  struct Group {
-    std::uint32_t coverage;
-    DepthRange range;
-  } groups[kMaxFragmentsPerPixel];
-  int group_of_root[kMaxFragmentsPerPixel];
-  int group_count = 0;
-  for (int i = 0; i < n; ++i) group_of_root[i] = -1;
-  for (int i = 0; i < n; ++i) {
-    int r = root(i);
-    if (group_of_root[r] < 0) {
-      group_of_root[r] = group_count;
-      groups[group_count++] = Group{0, range[i]};
-    }
-    Group& g = groups[group_of_root[r]];
-    group[i] = group_of_root[r];
-    g.coverage += cov[i];
-    g.range.min = std::min(g.range.min, range[i].min);
-    g.range.max = std::max(g.range.max, range[i].max);
+  bool front_separate = !crossing;
+  for (int j = 0; j < n && front_separate; ++j) {
+    if (!in_front[j] && !(front_max < range[j].min)) front_separate = false;
   }
 
   double weight[kMaxFragmentsPerPixel];
-  int front = 0;  // the group nearest at its nearest point
-  for (int g = 1; g < group_count; ++g) {
-    if (groups[g].range.min < groups[front].range.min) front = g;
-  }
-  bool front_separate = !crossing;
-  for (int g = 0; g < group_count; ++g) {
-    if (g != front && !(groups[front].range.max < groups[g].range.min)) front_separate = false;
-  }
-  if (front_separate &&
-      (group_count == 1 || groups[front].coverage >= std::uint32_t(kCoverageOne))) {
+  if (front_separate && (members == n || front_coverage >= std::uint32_t(kCoverageOne))) {
     // One surface in front of everything else in this pixel: its exact areas add, and when
     // they fill the pixel nothing behind shows. (Weights are normalised below if > 1.)
-    for (int i = 0; i < n; ++i) {
-      weight[i] = group[i] == front ? double(cov[i]) / kCoverageOne : 0.0;
-    }
+    for (int i = 0; i < n; ++i) weight[i] = in_front[i] ? double(cov[i]) / kCoverageOne : 0.0;
   } else {
-    // Visibility per sub-pixel sample, with per-sample depth from each plane.
-    std::uint64_t mask[kMaxFragmentsPerPixel];
-    int won[kMaxFragmentsPerPixel] = {};
-    double winner_z[64];
-    for (int i = 0; i < n; ++i) mask[i] = merged[i] ? merged_mask[i] : sample_mask(*tri[i], x, y);
-    for (int s = 0; s < 64; ++s) {
-      const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
-      int best = -1;
-      double best_z =
-          opaque != nullptr ? opaque->depth_at(sx, sy) : std::numeric_limits<double>::infinity();
-      std::uint32_t best_primitive = opaque != nullptr ? opaque->primitive : kNoTriangle;
-      for (int i = 0; i < n; ++i) {
-        if (!(mask[i] >> s & 1)) continue;
-        double z = tri[i]->depth_at(sx, sy);
-        // Nearest wins; equal depth keeps the earlier triangle.
-        if (z < best_z || (z == best_z && tri[i]->primitive < best_primitive)) {
-          best = i;
-          best_z = z;
-          best_primitive = tri[i]->primitive;
-        }
-      }
-      if (best >= 0) ++won[best];
-      winner_z[s] = best_z;
-    }
-    for (int i = 0; i < n; ++i) {
-      int samples = std::popcount(mask[i]);
-      double share;
-      if (samples > 0) {
-        share = double(won[i]) / samples;
-      } else {
-        // Too small to own a sample: spread it over the pixel, and count the samples where
-        // its plane would be nearer than what won them.
-        int nearer = 0;
-        for (int s = 0; s < 64; ++s) {
-          const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
-          nearer += tri[i]->depth_at(sx, sy) < winner_z[s];
-        }
-        share = nearer / 64.0;
-      }
-      weight[i] = double(cov[i]) / kCoverageOne * share;
-    }
+    sample_weights(x, y, opaque, n, tri, cov, merged, weight);
   }
   double total = 0;
   for (int i = 0; i < n; ++i) total += weight[i];
@@ -407,7 +357,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
   for (int i = 0; i < n; ++i) {
     if (weight[i] == 0) continue;
-    const glm::vec3 c = merged[i] ? merged_color[i] : shade(*tri[i], cx, cy, true);
+    const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
     double w = weight[i] * scale;
     r += w * c.r;
     g += w * c.g;
@@ -416,20 +366,92 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   return glm::vec3(float(r), float(g), float(b));
 }
 
+/// Visibility per sub-pixel sample, with per-sample depth from each plane: a fragment's
+/// weight is its coverage times the share of its samples where it is the nearest (equal
+/// depth keeps the earlier triangle). Only the samples a fragment owns are evaluated.
+void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n,
+                                 const TriangleSetup* const* tri, const std::uint32_t* cov,
+                                 const MergedPiece* const* merged, double* weight) const {
+  constexpr int kSamples = 64;
+  double best_z[kSamples];
+  std::uint32_t best_primitive[kSamples];
+  std::int8_t best[kSamples];
+  for (int s = 0; s < kSamples; ++s) {
+    const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
+    best_z[s] =
+        opaque != nullptr ? opaque->depth_at(sx, sy) : std::numeric_limits<double>::infinity();
+    best_primitive[s] = opaque != nullptr ? opaque->primitive : kNoTriangle;
+    best[s] = -1;
+  }
+  std::uint64_t mask[kMaxFragmentsPerPixel];
+  for (int i = 0; i < n; ++i) {
+    mask[i] = merged[i] != nullptr ? merged[i]->mask : sample_mask(*tri[i], x, y);
+    const std::uint32_t primitive = tri[i]->primitive;
+    for (std::uint64_t bits = mask[i]; bits != 0; bits &= bits - 1) {
+      const int s = std::countr_zero(bits);
+      const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
+      const double z = tri[i]->depth_at(sx, sy);
+      // Nearest wins; equal depth keeps the earlier triangle. The (depth, primitive) order
+      // is total, so the winner does not depend on the order fragments are visited in.
+      if (z < best_z[s] || (z == best_z[s] && primitive < best_primitive[s])) {
+        best_z[s] = z;
+        best_primitive[s] = primitive;
+        best[s] = std::int8_t(i);
+      }
+    }
+  }
+  int won[kMaxFragmentsPerPixel] = {};
+  for (int s = 0; s < kSamples; ++s) {
+    if (best[s] >= 0) ++won[best[s]];
+  }
+  for (int i = 0; i < n; ++i) {
+    const int samples = std::popcount(mask[i]);
+    double share;
+    if (samples > 0) {
+      share = double(won[i]) / samples;
+    } else {
+      // Too small to own a sample: spread it over the pixel, and count the samples where
+      // its plane would be nearer than what won them.
+      int nearer = 0;
+      for (int s = 0; s < kSamples; ++s) {
+        const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
+        nearer += tri[i]->depth_at(sx, sy) < best_z[s];
+      }
+      share = nearer / double(kSamples);
+    }
+    weight[i] = double(cov[i]) / kCoverageOne * share;
+  }
+}
+
 void ABufferTile::resolve(const FrameTarget& target) {
-  for (int y = rect_.y0; y < rect_.y1; ++y) {
-    for (int x = rect_.x0; x < rect_.x1; ++x) {
-      std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-      color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
+  if (uniform_valid_) {
+    // One opaque triangle (or the background) everywhere, as resolve_pixel would give it.
+    for (int y = rect_.y0; y < rect_.y1; ++y) {
+      for (int x = rect_.x0; x < rect_.x1; ++x) {
+        const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+        const double cx = x + 0.5, cy = y + 0.5;
+        color_[pixel] =
+            uniform_ != nullptr ? shade(*uniform_, cx, cy, true) : target.background_linear;
+        depth_[pixel] = uniform_ != nullptr ? float(uniform_->depth_at(cx, cy))
+                                            : std::numeric_limits<float>::infinity();
+      }
+    }
+  } else {
+    for (int y = rect_.y0; y < rect_.y1; ++y) {
+      for (int x = rect_.x0; x < rect_.x1; ++x) {
+        const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+        color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
+      }
     }
   }
   write_tile(target, rect_, color_.data(), depth_.data(), stride_);
 }
 
 std::size_t ABufferTile::scratch_bytes() const {
-  return opaque_.size() *
-             (sizeof(void*) + 2 * sizeof(std::uint32_t) + 1 + sizeof(glm::vec3) + sizeof(float)) +
-         pool_.capacity() * sizeof(Fragment);
+  return opaque_.size() * (sizeof(void*) + sizeof(double) + 2 * sizeof(std::uint32_t) + 1 +
+                           sizeof(glm::vec3) + sizeof(float)) +
+         pool_.capacity() * sizeof(Fragment) + merged_slot_.capacity() * sizeof(std::uint32_t) +
+         merged_.capacity() * sizeof(MergedPiece);
 }
 
 }  // namespace covrast::detail

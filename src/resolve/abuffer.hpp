@@ -17,8 +17,10 @@
 #pragma once
 
 #include "geometry/triangle_setup.hpp"
+#include "raster/coverage_kernel.hpp"
 #include "raster/tile_raster.hpp"
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -40,7 +42,14 @@ class ABufferTile {
 
   void begin_tile(const PixelRect& rect);
   /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile.
-  void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage);
+  inline void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage);
+  /// Whole-tile fast path for a triangle that covers every pixel of the tile: while every
+  /// pixel still shows one opaque triangle (or the background) and nothing else, the new
+  /// plane is compared with that one once, at the tile's corners (their difference is
+  /// affine, so extreme there), instead of pixel by pixel. Returns false when it cannot
+  /// decide (planes too close or crossing, or the tile is no longer uniform); the caller
+  /// then adds the triangle pixel by pixel, which gives what this would have.
+  bool add_covering_tile(const TriangleSetup* t);
   /// Resolves every pixel and writes the tile into the frame.
   void resolve(const FrameTarget& target);
 
@@ -48,40 +57,104 @@ class ABufferTile {
   std::uint64_t overflow_count() const { return overflows_; }
 
  private:
+  /// One triangle's piece of a pixel: 16 bytes, so a tile's lists stay in cache.
   struct Fragment {
-    const TriangleSetup* triangle;
-    std::uint32_t next;      ///< index into pool_, or kEnd
-    std::uint32_t coverage;  ///< 8.8, 1/255 units
-    std::uint64_t mask;      ///< 8x8 sample mask, valid only when merged
-    glm::vec3 color;         ///< when merged: coverage-weighted mean colour (linear)
-    std::uint32_t weight;    ///< when merged: summed coverage behind `color` (unclamped)
-    bool merged;             ///< stands for several triangles of one surface
+    const TriangleSetup* triangle;  ///< when merged: the piece whose plane stands for all
+    std::uint32_t next;             ///< index into pool_, or kEnd
+    std::uint32_t coverage;         ///< 8.8, 1/255 units; kMergedFlag: see merged_
   };
+  /// What a fragment that stands for several triangles of one surface keeps (overflow only).
+  struct MergedPiece {
+    std::uint64_t mask;    ///< 8x8 sample mask: the union of the pieces'
+    glm::vec3 color;       ///< coverage-weighted mean colour (linear)
+    std::uint32_t weight;  ///< summed coverage behind `color` (unclamped)
+  };
+  static constexpr std::uint32_t kMergedFlag = 0x80000000u;
   static constexpr std::uint32_t kEnd = 0xffffffffu;
 
-  DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z, std::size_t pixel,
-                                  int x, int y) const;
+  inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
+                                         std::size_t pixel, int x, int y) const;
+  /// Leaves the whole-tile state: writes the uniform opaque triangle into every pixel.
+  void materialize();
   void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                     std::uint32_t coverage);
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
-  /// Merges a piece (coverage, sample mask, colour at the pixel centre) into `f`.
-  void merge_into(Fragment& f, std::uint32_t coverage, std::uint64_t mask, glm::vec3 color, int x,
-                  int y);
+  /// Merges a piece (coverage, sample mask, colour at the pixel centre) into fragment `f`.
+  void merge_into(std::uint32_t f, std::uint32_t coverage, std::uint64_t mask, glm::vec3 color,
+                  int x, int y);
+  /// The merged data of fragment `f` (which has kMergedFlag).
+  const MergedPiece& merged_piece(std::uint32_t f) const { return merged_[merged_slot_[f]]; }
+  void sample_weights(int x, int y, const TriangleSetup* opaque, int n,
+                      const TriangleSetup* const* tri, const std::uint32_t* cov,
+                      const MergedPiece* const* merged, double* weight) const;
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
 
   int stride_;
   PixelRect rect_;
+  /// While uniform_valid_: every pixel's opaque triangle is uniform_ (null = background), no
+  /// pixel has fragments, and opaque_ / opaque_z_ are not written yet.
+  bool uniform_valid_ = true;
+  const TriangleSetup* uniform_ = nullptr;
   std::vector<const TriangleSetup*> opaque_;  ///< per pixel, null = background
   std::vector<double> opaque_z_;              ///< per pixel, the opaque plane at the centre
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
   std::vector<Fragment> pool_;
+  std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
+  std::vector<MergedPiece> merged_;
   std::vector<glm::vec3> color_;  ///< resolved linear colour
   std::vector<float> depth_;      ///< resolved window depth
   std::uint64_t overflows_ = 0;
 };
+
+/// How plane `t` lies against plane `other` over pixel (x, y), from their depths at the
+/// pixel's four corners (abuffer.cpp).
+DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y);
+
+/// order_of, decided in most cases from the planes' difference at the pixel centre and a
+/// bound on how far it can move towards a corner: |d(corner) - d(centre)| <=
+/// (|ddz/dx| + |ddz/dy|) / 2. Near ties it falls back to the exact corner comparison.
+inline DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, double t_centre_z,
+                                                    std::size_t pixel, int x, int y) const {
+  const TriangleSetup& o = *opaque_[pixel];
+  const double d = t_centre_z - opaque_z_[pixel];
+  const double reach = 0.5 * (std::fabs(t.dzdx - o.dzdx) + std::fabs(t.dzdy - o.dzdy));
+  constexpr double kMargin = 1e-12;  // far above the rounding of z in [0, 1]
+  if (d + reach < -kMargin) return DepthOrder::InFront;
+  if (d - reach > kMargin) return DepthOrder::Behind;
+  return order_of(t, o, x, y);
+}
+
+inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
+  if (uniform_valid_) materialize();
+  const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+  const double centre_z = t->depth_at(x + 0.5, y + 0.5);
+  if (opaque_[pixel] == nullptr) {
+    if (coverage == std::uint32_t(kCoverageOne)) {
+      opaque_[pixel] = t;
+      opaque_z_[pixel] = centre_z;
+      return;
+    }
+  } else {
+    switch (order_against_opaque(*t, centre_z, pixel, x, y)) {
+      case DepthOrder::InFront:
+        // A fully covered pixel is an ordinary depth test.
+        if (coverage == std::uint32_t(kCoverageOne)) {
+          opaque_[pixel] = t;
+          opaque_z_[pixel] = centre_z;
+          return;
+        }
+        break;
+      case DepthOrder::Behind:
+        return;  // hidden everywhere in the pixel
+      case DepthOrder::Crossing:
+        break;  // kept as a fragment, resolved per sample
+    }
+  }
+  add_fragment(pixel, x, y, t, coverage);
+}
 
 }  // namespace covrast::detail
