@@ -42,17 +42,23 @@ struct RenderOptions {
   int threads = 0;  ///< 0: all hardware threads
   int tile = 64;    ///< tile side [pixels], 8..256, a multiple of 8
   bool want_depth = false;
+  /// Drop the back faces of closed meshes wherever that provably cannot change the image
+  /// (eye outside the mesh, no vertex clipped by the near or far plane; see
+  /// docs/architecture.md). false keeps every triangle, to debug or measure the effect.
+  bool cull_hidden_backfaces = true;
 };
 
 struct RenderStats {
-  std::uint64_t triangles_in = 0;       ///< triangles submitted (after load-time drops)
-  std::uint64_t triangles_culled = 0;   ///< wholly outside the view volume or zero area
-  std::uint64_t triangles_clipped = 0;  ///< that needed clipping against a plane
-  std::uint64_t triangles_setup = 0;    ///< screen triangles that reached binning
-  std::uint64_t bin_entries = 0;        ///< (triangle, tile) pairs
-  std::uint64_t fragment_overflows = 0; ///< coverage mode: fragments merged on list overflow
-  std::uint64_t scratch_bytes = 0;      ///< peak tile-local scratch over all threads
-  double setup_ms = 0;    ///< transform, clip, snap, setup
+  std::uint64_t triangles_in = 0;               ///< triangles submitted (after load-time drops)
+  std::uint64_t triangles_culled = 0;           ///< wholly outside the view volume, zero area, or
+                                                ///< a hidden back face (every dropped triangle)
+  std::uint64_t triangles_backface_culled = 0;  ///< of triangles_culled: hidden back faces
+  std::uint64_t triangles_clipped = 0;          ///< that needed clipping against a plane
+  std::uint64_t triangles_setup = 0;            ///< screen triangles that reached binning
+  std::uint64_t bin_entries = 0;                ///< (triangle, tile) pairs
+  std::uint64_t fragment_overflows = 0;  ///< coverage mode: fragments merged on list overflow
+  std::uint64_t scratch_bytes = 0;       ///< peak tile-local scratch over all threads
+  double setup_ms = 0;                   ///< transform, clip, snap, setup
   double binning_ms = 0;
   double raster_ms = 0;   ///< tile raster including per-tile resolve
   double resolve_ms = 0;  ///< frame-level resolve (linear -> sRGB, copy-out)
@@ -70,7 +76,7 @@ struct RenderResult {
 /// Keeps per-frame memory between frames, so repeated frames (benchmarks, --repeat)
 /// do not reallocate. Not thread-safe: one frame at a time per Renderer.
 class Renderer {
-public:
+ public:
   /// Throws InputError for bad options (size, tile, mode parameters).
   Renderer(const Scene& scene, const RenderOptions& options);
   ~Renderer();
@@ -79,7 +85,7 @@ public:
 
   RenderResult render_frame();
 
-private:
+ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -27,6 +27,7 @@ struct RenderArgs {
   int repeat = 1;
   bool strict = false;
   bool quiet = false;
+  bool no_cull = false;  ///< keep hidden back faces (RenderOptions::cull_hidden_backfaces)
 };
 
 struct InfoArgs {

@@ -72,6 +72,7 @@ nlohmann::ordered_json stats_json(const RenderOptions& options, const RenderResu
   j["tile"] = s.tile;
   j["triangles"] = {{"in", s.triangles_in},
                     {"culled", s.triangles_culled},
+                    {"backface_culled", s.triangles_backface_culled},
                     {"clipped", s.triangles_clipped},
                     {"setup", s.triangles_setup},
                     {"bin_entries", s.bin_entries}};
@@ -139,6 +140,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->type_name("K");
   sub->add_flag("--strict", args.strict, "Treat scene warnings as errors (exit 2, no output)");
   sub->add_flag("-q,--quiet", args.quiet, "Do not print the 'wrote ...' lines");
+  sub->add_flag("--no-cull", args.no_cull,
+                "Keep the back faces of closed meshes (by default they are dropped where that "
+                "provably cannot change the image); for debugging and measuring");
   return sub;
 }
 
@@ -149,6 +153,7 @@ int run_render(const RenderArgs& args) {
   options.threads = args.threads;
   options.tile = args.tile;
   options.want_depth = !args.depth.empty();
+  options.cull_hidden_backfaces = !args.no_cull;
 
   check_output_path(args.output, {".png"});
   if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});

@@ -21,10 +21,46 @@ using ClipPolygon = std::array<ClipVertex, 12>;
 /// Homogeneous plane: inside where dot(plane, position) >= 0.
 using ClipPlane = glm::dvec4;
 
+/// Outcode bits of the near and far planes (planes_[0] and planes_[1]).
+constexpr unsigned kNearFarBits = 1u << 0 | 1u << 1;
+
 }  // namespace
 
-GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_px)
-    : scene_(scene), width_px_(width_px), height_px_(height_px) {
+// Hidden back-face culling. The back faces of an instance are dropped when all of these hold:
+//  (a) its mesh is closed and consistently oriented, every edge-connected component with a
+//      clearly non-zero signed volume of one sign s_mesh (analyze_mesh_topology);
+//  (b) the model matrix is affine with det != 0, and the eye, taken into object space, lies
+//      strictly outside the mesh's bounding box;
+//  (c) this frame, no vertex of the instance is outside the near or the far plane.
+// Why the image cannot change: orient every face by s_world = s_mesh * sign(det(model)) (a
+// mirroring model matrix flips it), so that all components face outwards. The winding number
+// of the surface is then 0 outside it and >= 0 everywhere (for a surface that does not pass
+// through itself), and it changes by +1 where a ray crosses a face from its outer side. A ray
+// from the eye starts at winding 0 ((b): the eye is outside the box, so outside the surface),
+// so the first face it meets is crossed from the outside: a front face. By (c) no clip plane
+// cuts the surface open (the side planes act only beyond the guard band, outside the image),
+// so every triangle reaches the screen whole, and along every ray through the image a front
+// face of the instance lies in front of each of its back faces: no back face is ever the
+// nearest surface. An outward face seen from outside is counter-clockwise on screen when
+// s_world > 0, so the dropped facing is clockwise (front_facing false) for s_world > 0 and
+// counter-clockwise for s_world < 0.
+// With a perspective camera, (c) alone already puts the eye outside the mesh's convex hull
+// (every vertex is at least `near` in front of it); (b) is a cheap second guard. covrast's
+// camera is perspective only; an orthographic one would have the eye at infinity and parallel
+// rays that start on the near plane, so (c) alone would suffice there and (b) would drop out.
+// Snapping keeps shared vertices shared, so the snapped surface is closed too; the only place
+// where a back face can tie with (or, by a rounding step, beat) a front face is an edge where
+// the two meet, both of the same instance: with a uniform colour the pixel is the same either
+// way. Not detected: a single surface that passes through itself with part of it turned
+// inside out (negative winding); such a mesh is not a valid solid.
+
+GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_px,
+                                   bool cull_hidden_backfaces)
+    : scene_(scene),
+      width_px_(width_px),
+      height_px_(height_px),
+      cull_hidden_backfaces_(cull_hidden_backfaces),
+      eye_(scene.camera.eye) {
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
   glm::dmat4 projection = glm::perspective(glm::radians(cam.fovy_deg),
@@ -44,6 +80,9 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
   }
   vertices_.resize(scene.meshes.size());
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    vertices_[i].block_outcodes.resize(
+        (scene.meshes[i].mesh->positions.size() + kVerticesPerTransformBlock - 1) /
+        kVerticesPerTransformBlock);
     vertices_[i].clip.resize(scene.meshes[i].mesh->positions.size());
     vertices_[i].outcode.resize(scene.meshes[i].mesh->positions.size());
     vertices_[i].snapped.resize(scene.meshes[i].mesh->positions.size());
@@ -51,6 +90,39 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       vertices_[i].color_linear.resize(scene.meshes[i].mesh->positions.size());
     }
   }
+}
+
+unsigned GeometryFrontEnd::cullable_facing(const MeshInstance& instance, const glm::dvec3& eye) {
+  const MeshData& mesh = *instance.mesh;
+  if (mesh.closed_orientation == 0 || mesh.analyzed_triangle_count != mesh.triangle_count()) {
+    return 0;  // (a) fails, or the analysis is stale
+  }
+  const glm::dmat4& m = instance.model;
+  // (b). Affine: the bottom row (GLM: m[column][3]) is (0, 0, 0, 1), so w stays 1 and the
+  // orientation in world space is the sign of the 3x3 part's determinant.
+  if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0) return 0;
+  const double det = glm::determinant(glm::dmat3(m));
+  if (!std::isfinite(det) || det == 0.0) return 0;
+  const glm::dvec3 e = glm::dvec3(glm::inverse(m) * glm::dvec4(eye, 1.0));
+  const glm::dvec3 lo(mesh.bounds_min), hi(mesh.bounds_max);
+  // Written so that NaN (a degenerate inverse) counts as inside.
+  const bool outside =
+      e.x < lo.x || e.x > hi.x || e.y < lo.y || e.y > hi.y || e.z < lo.z || e.z > hi.z;
+  if (!outside) return 0;
+  const int world_sign = det > 0.0 ? mesh.closed_orientation : -mesh.closed_orientation;
+  return world_sign > 0 ? kDropClockwise : kDropCounterClockwise;
+}
+
+unsigned GeometryFrontEnd::drop_facing(std::size_t instance) const {
+  if (!cull_hidden_backfaces_) return 0;
+  // (a) and (b) from the instance as it is now (its model matrix may change between frames).
+  // Once per instance and chunk; meshes that are not closed stop at the first test.
+  const unsigned facing = cullable_facing(scene_.meshes[instance], eye_);
+  if (facing == 0) return 0;
+  // (c), from this frame's outcodes (unreferenced vertices included: conservative).
+  unsigned codes = 0;
+  for (const std::uint8_t block : vertices_[instance].block_outcodes) codes |= block;
+  return (codes & kNearFarBits) != 0 ? 0 : facing;
 }
 
 std::size_t GeometryFrontEnd::vertex_count(std::size_t instance) const {
@@ -81,12 +153,21 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
   const MeshInstance& inst = scene_.meshes[instance];
   const glm::dmat4 mvp = view_projection_ * inst.model;
   InstanceVertices& out = vertices_[instance];
-  for (std::size_t v = begin; v < end; ++v) {
-    const glm::dvec4 clip = mvp * glm::dvec4(glm::dvec3(inst.mesh->positions[v]), 1.0);
-    const auto code = std::uint8_t(outcode(clip));
-    out.clip[v] = clip;
-    out.outcode[v] = code;
-    if (code == 0) out.snapped[v] = snap(clip);
+  // Block by block, each block's outcode union into its own slot.
+  for (std::size_t block_begin = begin; block_begin < end;) {
+    const std::size_t block = block_begin / kVerticesPerTransformBlock;
+    const std::size_t block_end = std::min(end, (block + 1) * kVerticesPerTransformBlock);
+    unsigned codes = 0;
+    for (std::size_t v = block_begin; v < block_end; ++v) {
+      const glm::dvec4 clip = mvp * glm::dvec4(glm::dvec3(inst.mesh->positions[v]), 1.0);
+      const auto code = std::uint8_t(outcode(clip));
+      out.clip[v] = clip;
+      out.outcode[v] = code;
+      codes |= code;
+      if (code == 0) out.snapped[v] = snap(clip);
+    }
+    out.block_outcodes[block] = std::uint8_t(codes);
+    block_begin = block_end;
   }
   if (inst.color_source == ColorSource::Vertex) {
     const auto& colors = inst.mesh->colors_linear;
@@ -124,6 +205,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     if (g >= run_end) continue;  // an instance without triangles
     const MeshInstance& inst = scene_.meshes[instance];
     const InstanceVertices& iv = vertices_[instance];
+    sink.drop_facing = drop_facing(instance);
     const std::uint32_t* indices = inst.mesh->indices.data() + (g - first_triangle_[instance]) * 3;
     // A uniform colour is flat unless it is NaN (the per-triangle comparison's result).
     const glm::vec3 uniform = inst.color_linear;
@@ -189,14 +271,21 @@ void GeometryFrontEnd::emit_triangle(const SnappedVertex& v0, const SnappedVerte
     ++sink.counters.culled;
     return;
   }
+  // CCW in NDC (y up) is negative area with y down. Checked after the image test, so that
+  // backface_culled counts exactly the triangles that culling keeps from binning.
+  const bool front = area2 < 0;
+  if ((sink.drop_facing & (front ? kDropCounterClockwise : kDropClockwise)) != 0) {
+    ++sink.counters.culled;
+    ++sink.counters.backface_culled;
+    return;
+  }
   if (sink.bounds != nullptr) {
     // Non-empty: a triangle of non-zero area has min < max on both axes.
     sink.bounds->push_back(PixelBounds16{
         std::uint16_t(std::max(r.x0, 0)), std::uint16_t(std::max(r.y0, 0)),
         std::uint16_t(std::min(r.x1, width_px_)), std::uint16_t(std::min(r.y1, height_px_))});
   }
-  // CCW in NDC (y up) is negative area with y down; reorder to positive area.
-  const bool front = area2 < 0;
+  // Reorder to positive area.
   const SnappedVertex& s0 = v0;
   const SnappedVertex& s1 = front ? v2 : v1;
   const SnappedVertex& s2 = front ? v1 : v2;

@@ -4,6 +4,9 @@
 // Work is split into fixed chunks of the global triangle sequence (all meshes in list
 // order, faces in file order), so that the output order, and so the image, never depends
 // on the thread count.
+//
+// Hidden back faces of closed meshes are dropped here (see the comment at GeometryFrontEnd's
+// constructor in frontend.cpp for why that never changes the image).
 #pragma once
 
 #include "geometry/triangle_setup.hpp"
@@ -23,6 +26,11 @@ namespace covrast::detail {
 /// balance 500k triangles over a few cores.
 inline constexpr std::uint32_t kTrianglesPerChunk = 8192;
 
+/// Vertices per transform block: transform_vertices calls must cover whole blocks of an
+/// instance (begin a multiple of it, end a multiple of it or the vertex count), since each
+/// block records the union of its vertices' outcodes in its own slot.
+inline constexpr std::size_t kVerticesPerTransformBlock = 4096;
+
 /// A vertex after the viewport transform, snapped to 24.8 fixed point.
 struct SnappedVertex {
   std::int32_t x_fx8;
@@ -38,6 +46,9 @@ struct InstanceVertices {
   std::vector<std::uint8_t> outcode;    ///< bit p set: outside clip plane p
   std::vector<SnappedVertex> snapped;   ///< valid where outcode == 0
   std::vector<glm::vec3> color_linear;  ///< only for ColorSource::Vertex
+  /// Per kVerticesPerTransformBlock vertices: the union (OR) of their outcodes. Each slot is
+  /// written by one transform call, so the per-instance union is race-free and deterministic.
+  std::vector<std::uint8_t> block_outcodes;
 };
 
 /// An allocator whose value-less construct() default-initialises: a vector of it grows
@@ -60,13 +71,17 @@ struct DefaultInitAllocator : std::allocator<T> {
 using SetupVector = std::vector<TriangleSetup, DefaultInitAllocator<TriangleSetup>>;
 
 struct SetupCounters {
-  std::uint64_t culled = 0;   ///< outside the view volume, or zero area after snapping
-  std::uint64_t clipped = 0;  ///< crossed a clip plane
+  std::uint64_t culled = 0;           ///< outside the view volume, zero area after snapping, or a
+                                      ///< hidden back face
+  std::uint64_t clipped = 0;          ///< crossed a clip plane
+  std::uint64_t backface_culled = 0;  ///< of culled: hidden back faces of closed meshes
 };
 
 class GeometryFrontEnd {
  public:
-  GeometryFrontEnd(const Scene& scene, int width_px, int height_px);
+  /// `cull_hidden_backfaces`: RenderOptions::cull_hidden_backfaces.
+  GeometryFrontEnd(const Scene& scene, int width_px, int height_px,
+                   bool cull_hidden_backfaces = true);
 
   std::uint64_t triangle_count() const { return first_triangle_.back(); }
   std::uint32_t chunk_count() const {
@@ -79,7 +94,8 @@ class GeometryFrontEnd {
   }
   std::size_t instance_count() const { return scene_.meshes.size(); }
 
-  /// Transforms the vertices of one instance (vertices [begin, end)) to clip space.
+  /// Transforms the vertices of one instance (vertices [begin, end)) to clip space. The range
+  /// covers whole transform blocks (see kVerticesPerTransformBlock).
   void transform_vertices(std::size_t instance, std::size_t begin, std::size_t end);
   std::size_t vertex_count(std::size_t instance) const;
 
@@ -100,6 +116,9 @@ class GeometryFrontEnd {
     SetupVector* setups;
     std::vector<PixelBounds16>* bounds;
     SetupCounters& counters;
+    /// Facings dropped as hidden back faces for the current instance: kDropClockwise,
+    /// kDropCounterClockwise or 0.
+    unsigned drop_facing = 0;
     /// A new triangle at the end of the output, its fields to be written.
     TriangleSetup& next() {
       return setups != nullptr ? setups->emplace_back() : out->emplace_back();
@@ -111,6 +130,15 @@ class GeometryFrontEnd {
   void clip_triangle(std::size_t instance, const std::uint32_t* idx, const glm::vec3* color,
                      bool flat, unsigned out_any, std::uint32_t primitive, Sink& sink) const;
   void setup_range(std::uint32_t chunk, Sink& sink) const;
+  /// Which facing of an instance to drop this frame (Sink::drop_facing).
+  unsigned drop_facing(std::size_t instance) const;
+  /// Conditions (a) and (b) (see frontend.cpp): the facing to drop if no vertex is clipped by
+  /// the near or far plane, or 0.
+  static unsigned cullable_facing(const MeshInstance& instance, const glm::dvec3& eye);
+
+  /// TriangleSetup::front_facing false (clockwise in NDC) / true (counter-clockwise).
+  static constexpr unsigned kDropClockwise = 1;
+  static constexpr unsigned kDropCounterClockwise = 2;
 
   const Scene& scene_;
   int width_px_;
@@ -121,6 +149,8 @@ class GeometryFrontEnd {
   glm::dvec4 planes_[6];  ///< homogeneous clip planes: inside where dot(plane, v) >= 0
   std::vector<std::uint64_t> first_triangle_;  ///< prefix sums of triangle counts
   std::vector<InstanceVertices> vertices_;
+  bool cull_hidden_backfaces_;
+  glm::dvec3 eye_;  ///< the camera position the view matrix was built from [world]
 };
 
 }  // namespace covrast::detail

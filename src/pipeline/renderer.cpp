@@ -83,8 +83,8 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
-/// Vertices per transform task.
-constexpr std::size_t kVerticesPerBlock = 4096;
+/// Vertices per transform task: whole blocks, as transform_vertices requires.
+constexpr std::size_t kVerticesPerBlock = detail::kVerticesPerTransformBlock;
 
 }  // namespace
 
@@ -112,7 +112,7 @@ struct Renderer::Impl {
         height_px(h),
         threads(t),
         grid(w, h, o.tile),
-        front_end(s, w, h),
+        front_end(s, w, h, o.cull_hidden_backfaces),
         arena(t),
         rasterizers(
             [mode = o.mode, tile = o.tile] { return detail::make_tile_rasterizer(mode, tile); }) {
@@ -215,6 +215,7 @@ RenderResult Renderer::render_frame() {
   for (const auto& c : im.setup_counters) {
     st.triangles_culled += c.culled;
     st.triangles_clipped += c.clipped;
+    st.triangles_backface_culled += c.backface_culled;
   }
   for (const auto& tris : im.chunk_triangles) st.triangles_setup += tris.size();
   for (const auto& b : im.chunk_bins) st.bin_entries += b.triangle_index.size();

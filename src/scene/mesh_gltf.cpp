@@ -486,6 +486,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
     loaded.uniform_color_linear = first_factor;
   }
   loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
+  analyze_mesh_topology(*mesh);  // once per file: instances share the result
   loaded.data = std::move(mesh);
   return loaded;
 }

@@ -191,6 +191,7 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
   }
   LoadedMesh loaded;
   loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
+  analyze_mesh_topology(*mesh);  // once per file: instances share the result
   loaded.data = std::move(mesh);
   return loaded;
 }
