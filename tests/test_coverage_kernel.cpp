@@ -1,9 +1,12 @@
 // Tests of the coverage kernel (src/raster/coverage_kernel.hpp): its 8.8 coverage against the
 // exact area of triangle ∩ pixel (a Sutherland-Hodgman clip in double on the snapped vertices),
 // bit identity of the SIMD kernel on every target this CPU runs with the scalar twin, and exact
-// sums (kCoverageOne) over tessellations. The helpers drive the kernel the way
-// CoverageRasterizer::draw (src/raster/coverage.cpp) does: groups of kColumnGroup columns,
-// lanes past the span zeroed, kernel on the partial runs and the piece width on the interior.
+// sums (kCoverageOne) over tessellations. Also the set-up's fast paths against their
+// references: the vertex sorting network against std::sort, and the SIMD column set-up on
+// every target against its scalar twin (all five arrays, all lanes, the group's rows).
+// The helpers drive the kernel the way CoverageRasterizer::draw (src/raster/coverage.cpp)
+// does: groups of kColumnGroup columns, lanes past the span zeroed, kernel on the partial
+// runs and the piece width on the interior.
 #include "geometry/triangle_setup.hpp"
 #include "raster/coverage_kernel.hpp"
 
@@ -13,9 +16,12 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <memory>
 #include <random>
 #include <sstream>
@@ -144,7 +150,9 @@ struct KernelRun {
   std::uint64_t nonzero_beyond_span = 0;  ///< kernel output != 0 in a zeroed lane
 };
 
-/// Runs make_coverage_triangle + setup_column + `fn` over `window` ∩ the triangle's box.
+/// Runs make_coverage_triangle + the column set-up + `fn` over `window` ∩ the triangle's box.
+/// The scalar kernel runs with the scalar set-up (setup_column_group_scalar), so the
+/// reference is scalar end to end; any other kernel with the dispatched SIMD set-up, as draw.
 KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRowsFn fn,
                      RowMode mode) {
   static thread_local std::unique_ptr<CoverageColumns> cols_ptr =
@@ -162,7 +170,9 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
     const int lanes = std::min(kColumnGroup, r.x1 - g);
     // The same set-up as CoverageRasterizer::draw.
     const covrast::detail::GroupRows rows =
-        covrast::detail::setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
+        fn == covrast::detail::coverage_rows_scalar
+            ? covrast::detail::setup_column_group_scalar(tri, g, lanes, r.y0, r.y1, cols)
+            : covrast::detail::setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
     // Poison the buffer: a row of [first, end) that nothing writes shows up as a mismatch.
     std::fill(buf.begin(), buf.end(), kPoison);
     int copy_begin = r.y0, copy_end = r.y1;
@@ -579,6 +589,324 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
   INFO(first);
   CHECK(compared == 3000u * targets.size() * kRows * kColumnGroup);
   CHECK(differing == 0);
+}
+
+// ---- Triangle and column set-up: the fast paths against their references ---------------
+
+namespace {
+
+using covrast::detail::CoverageEdge;
+using covrast::detail::GroupRows;
+
+/// make_coverage_triangle as first written (std::sort on (x, y), then canonical edges): the
+/// reference for its sorting network.
+CoverageTriangle reference_coverage_triangle(const TriangleSetup& t) {
+  int order[3] = {0, 1, 2};
+  std::sort(order, order + 3, [&](int i, int j) {
+    return t.x_fx8[i] < t.x_fx8[j] || (t.x_fx8[i] == t.x_fx8[j] && t.y_fx8[i] < t.y_fx8[j]);
+  });
+  auto edge = [](double xa, double ya, double xb, double yb) {
+    if (xb < xa || (xb == xa && yb < ya)) {
+      std::swap(xa, xb);
+      std::swap(ya, yb);
+    }
+    CoverageEdge e{xa, ya, xb, yb, 0.0};
+    if (xb > xa) e.slope = (yb - ya) / (xb - xa);
+    return e;
+  };
+  const std::int64_t xa = t.x_fx8[order[0]], ya = t.y_fx8[order[0]];
+  const std::int64_t xb = t.x_fx8[order[1]], yb = t.y_fx8[order[1]];
+  const std::int64_t xc = t.x_fx8[order[2]], yc = t.y_fx8[order[2]];
+  const double s = 1.0 / kSubpixelOne;
+  CoverageTriangle tri;
+  tri.edge[0] = edge(xa * s, ya * s, xc * s, yc * s);
+  tri.edge[1] = edge(xa * s, ya * s, xb * s, yb * s);
+  tri.edge[2] = edge(xb * s, yb * s, xc * s, yc * s);
+  const std::int64_t cross = (xc - xa) * (yb - ya) - (yc - ya) * (xb - xa);
+  tri.sign = cross > 0 ? -1 : +1;
+  tri.x_min = xa * s;
+  tri.x_max = xc * s;
+  return tri;
+}
+
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
+
+bool same_triangle(const CoverageTriangle& a, const CoverageTriangle& b) {
+  for (int e = 0; e < 3; ++e) {
+    const CoverageEdge &p = a.edge[e], &q = b.edge[e];
+    if (!same_bits(p.x0, q.x0) || !same_bits(p.y0, q.y0) || !same_bits(p.x1, q.x1) ||
+        !same_bits(p.y1, q.y1) || !same_bits(p.slope, q.slope)) {
+      return false;
+    }
+  }
+  return a.sign == b.sign && same_bits(a.x_min, b.x_min) && same_bits(a.x_max, b.x_max);
+}
+
+/// Highway targets compiled into the kernels and supported by this CPU, best first. Call
+/// before forcing any target: SupportedTargets() reports the mock once one is set.
+std::vector<std::int64_t> usable_targets() {
+  std::vector<std::int64_t> targets;
+  for (std::int64_t bits = covrast::detail::coverage_kernel_targets() & hwy::SupportedTargets();
+       bits != 0; bits &= bits - 1) {
+    targets.push_back(bits & -bits);
+  }
+  return targets;
+}
+
+/// Writes a quiet-NaN pattern (never a set-up value) to the group's lanes of all arrays, so
+/// a lane the set-up leaves unwritten differs from the reference.
+void poison_group(CoverageColumns& c, std::uint32_t pattern) {
+  for (int e = 0; e < 3; ++e) {
+    for (int lane = 0; lane < kColumnGroup; ++lane) {
+      c.t_left[e][lane] = std::bit_cast<float>(pattern);
+      c.t_right[e][lane] = std::bit_cast<float>(pattern + 1);
+      c.width_q[e][lane] = std::bit_cast<float>(pattern + 2);
+      c.slope_q[e][lane] = std::bit_cast<float>(pattern + 3);
+      c.base_row[e][lane] = std::int32_t(pattern + 4);
+    }
+  }
+}
+
+/// Compares lanes [0, kColumnGroup) of the five arrays bit for bit; on a difference,
+/// describes the first one.
+bool same_group(const CoverageColumns& simd, const CoverageColumns& scalar, std::string& what) {
+  struct Array {
+    const char* name;
+    const void* simd;
+    const void* scalar;
+  };
+  for (int e = 0; e < 3; ++e) {
+    const Array arrays[] = {{"t_left", simd.t_left[e], scalar.t_left[e]},
+                            {"t_right", simd.t_right[e], scalar.t_right[e]},
+                            {"width_q", simd.width_q[e], scalar.width_q[e]},
+                            {"slope_q", simd.slope_q[e], scalar.slope_q[e]},
+                            {"base_row", simd.base_row[e], scalar.base_row[e]}};
+    for (const Array& a : arrays) {
+      for (int lane = 0; lane < kColumnGroup; ++lane) {
+        std::uint32_t x, y;  // all five arrays hold 4-byte elements
+        std::memcpy(&x, static_cast<const char*>(a.simd) + 4 * lane, 4);
+        std::memcpy(&y, static_cast<const char*>(a.scalar) + 4 * lane, 4);
+        if (x == y) continue;
+        std::ostringstream s;
+        s << a.name << "[" << e << "][" << lane << "]: simd bits 0x" << std::hex << x
+          << ", scalar bits 0x" << y;
+        what = s.str();
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+/// One call of the group set-up: a triangle, a group of columns, a row window.
+struct SetupCase {
+  TriangleSetup setup;
+  int col, lanes, row_min, row_max;
+};
+
+}  // namespace
+
+TEST_CASE("coverage set-up: the sorting network orders vertices as std::sort", "[coverage]") {
+  std::mt19937 rng(0x50a7u);
+  auto pick = [&](std::uint32_t n) {
+    return std::uniform_int_distribution<std::uint32_t>(0, n - 1)(rng);
+  };
+  // Coordinates from small sets (ties in x, in y, repeated vertices), anywhere in the guard
+  // band, and at the extremes of 24.8 fixed point, each sign.
+  auto coord = [&]() -> std::int32_t {
+    switch (pick(4)) {
+      case 0:
+        return (std::int32_t(pick(5)) - 2) * kSubpixelOne;
+      case 1:
+        return std::int32_t(pick(7)) - 3;
+      case 2:
+        return std::int32_t(pick(2 * 16384 * kSubpixelOne + 1)) - 16384 * kSubpixelOne;
+      default:
+        return pick(2) ? (1 << 23) - 1 - std::int32_t(pick(3)) : -(1 << 23) + std::int32_t(pick(3));
+    }
+  };
+  std::uint64_t compared = 0, mismatches = 0, x_ties = 0;
+  std::string first;
+  for (int n = 0; n < 20000; ++n) {
+    std::int32_t x[3], y[3];
+    for (int k = 0; k < 3; ++k) {
+      x[k] = coord();
+      y[k] = coord();
+    }
+    if (x[0] == x[1] || x[1] == x[2] || x[0] == x[2]) ++x_ties;
+    int perm[3] = {0, 1, 2};
+    do {
+      TriangleSetup t{};
+      for (int k = 0; k < 3; ++k) {
+        t.x_fx8[k] = x[perm[k]];
+        t.y_fx8[k] = y[perm[k]];
+      }
+      ++compared;
+      if (same_triangle(covrast::detail::make_coverage_triangle(t), reference_coverage_triangle(t)))
+        continue;
+      if (++mismatches == 1) first = describe(t);
+    } while (std::next_permutation(perm, perm + 3));
+  }
+  INFO("first mismatch: " << first);
+  CHECK(compared == 120000);
+  CHECK(x_ties > 1000);
+  CHECK(mismatches == 0);
+}
+
+TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[coverage]") {
+  const std::vector<std::int64_t> targets = usable_targets();
+  REQUIRE(!targets.empty());
+  std::mt19937 rng(0x5e7091u);
+  auto pick = [&](std::uint32_t n) {
+    return std::uniform_int_distribution<std::uint32_t>(0, n - 1)(rng);
+  };
+  auto uniform = [&](double lo, double hi) {
+    return std::uniform_real_distribution<double>(lo, hi)(rng);
+  };
+
+  // Triangles: the kernel tests' mix (ordinary, slivers, in-pixel, on the pixel grid, huge
+  // up to +-16384 px), right triangles with a vertical and a horizontal edge (on pixel
+  // borders half of the time), and small triangles far out at up to +-16384 px.
+  std::vector<TriangleSetup> tris;
+  TriangleGenerator gen(0x5e7091u);
+  for (const KindCount& kc : kMix) {
+    for (int n = 0; n < kc.count / 4; ++n) tris.push_back(gen.next(kc.kind).setup);
+  }
+  auto far_coord = [&]() {
+    const std::int32_t c = std::int32_t(pick(2 * 16384 - 64)) - 16384 + 32;
+    return c * kSubpixelOne + (pick(2) ? 0 : std::int32_t(pick(kSubpixelOne)));
+  };
+  auto extent = [&]() {
+    static constexpr double kSizes[] = {1.0 / 256, 0.5, 1.0, 3.0, 7.0, 20.0};
+    const double size = kSizes[pick(6)];
+    const std::int32_t d =
+        pick(2) ? std::int32_t(size * kSubpixelOne) : std::max(1, snap(uniform(0, size)));
+    return pick(2) ? d : -d;
+  };
+  while (tris.size() < 35000) {
+    const Fx8Point a{far_coord(), far_coord()};
+    const bool right = tris.size() < 30000;
+    Fx8Point b{a.x + extent(), a.y}, c{a.x, a.y + extent()};
+    if (!right) {
+      b = {a.x + extent(), a.y + extent()};
+      c = {a.x + extent(), a.y + extent()};
+    }
+    TriangleSetup t;
+    if (make_setup(a, b, c, t)) tris.push_back(t);
+  }
+
+  // Groups: the rasterizer's own (every group of the box, the last one partial), random
+  // groups that overhang the box or lie outside it with 0..8 lanes, and row windows that are
+  // the box's rows, cut through the triangle, or miss it.
+  std::vector<SetupCase> cases;
+  for (const TriangleSetup& t : tris) {
+    const PixelRect box = covrast::detail::touched_pixels(t);
+    auto rows = [&](SetupCase& sc) {
+      switch (pick(3)) {
+        case 0:
+          sc.row_min = box.y0;
+          sc.row_max = box.y1;
+          break;
+        case 1: {
+          const int h = box.y1 - box.y0;
+          sc.row_min = box.y0 - 2 + int(pick(std::uint32_t(std::min(h, 40) + 4)));
+          sc.row_max = sc.row_min + int(pick(std::uint32_t(std::min(h, 40) + 3)));
+          break;
+        }
+        default:
+          sc.row_min = INT_MIN / 2;
+          sc.row_max = INT_MAX / 2;
+      }
+    };
+    if (box.x1 - box.x0 <= 8 * kColumnGroup) {
+      for (int g = box.x0; g < box.x1; g += kColumnGroup) {
+        SetupCase sc{t, g, std::min(kColumnGroup, box.x1 - g), 0, 0};
+        rows(sc);
+        cases.push_back(sc);
+      }
+    } else {
+      for (int k = 0; k < 4; ++k) {
+        const int g = box.x0 + int(pick(std::uint32_t(box.x1 - box.x0)));
+        SetupCase sc{t, g, std::min(kColumnGroup, box.x1 - g), 0, 0};
+        rows(sc);
+        cases.push_back(sc);
+      }
+    }
+    const int width = std::min(box.x1 - box.x0, 64);
+    for (int k = 0; k < 2; ++k) {
+      SetupCase sc{t, box.x0 - 10 + int(pick(std::uint32_t(width + 12))),
+                   int(pick(kColumnGroup + 1)), 0, 0};
+      rows(sc);
+      cases.push_back(sc);
+    }
+  }
+
+  // The scalar twin's results, once.
+  auto scalar_cols = std::make_unique<CoverageColumns>();
+  auto simd_cols = std::make_unique<CoverageColumns>();
+  std::vector<GroupRows> scalar_rows(cases.size());
+  std::uint64_t partial = 0, empty = 0, interior = 0, clipped = 0;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const SetupCase& sc = cases[i];
+    const CoverageTriangle tri = covrast::detail::make_coverage_triangle(sc.setup);
+    const GroupRows g = covrast::detail::setup_column_group_scalar(
+        tri, sc.col, sc.lanes, sc.row_min, sc.row_max, *scalar_cols);
+    scalar_rows[i] = g;
+    partial += sc.lanes < kColumnGroup;
+    empty += g.empty();
+    interior += g.interior_begin < g.interior_end;
+    const GroupRows unclipped = covrast::detail::setup_column_group_scalar(
+        tri, sc.col, sc.lanes, INT_MIN / 2, INT_MAX / 2, *scalar_cols);
+    clipped += !g.empty() && (g.first != unclipped.first || g.end != unclipped.end);
+  }
+  WARN("column set-up: " << tris.size() << " triangles, " << cases.size() << " groups (" << partial
+                         << " partial, " << empty << " empty, " << interior
+                         << " with an interior run, " << clipped << " clipped) on "
+                         << targets.size() << " targets");
+  CHECK(partial > 20000);
+  CHECK(empty > 2000);
+  CHECK(interior > 5000);
+  CHECK(clipped > 5000);
+
+  for (std::int64_t target : targets) {
+    covrast::detail::force_coverage_kernel_target(target);
+    INFO("target " << hwy::TargetName(target));
+    std::uint64_t differing = 0;
+    std::string first;
+    for (std::size_t i = 0; i < cases.size(); ++i) {
+      const SetupCase& sc = cases[i];
+      const CoverageTriangle tri = covrast::detail::make_coverage_triangle(sc.setup);
+      poison_group(*scalar_cols, 0x7fc00010u);
+      poison_group(*simd_cols, 0x7fc00020u);
+      covrast::detail::setup_column_group_scalar(tri, sc.col, sc.lanes, sc.row_min, sc.row_max,
+                                                 *scalar_cols);
+      const GroupRows g = covrast::detail::setup_column_group(tri, sc.col, sc.lanes, sc.row_min,
+                                                              sc.row_max, *simd_cols);
+      const GroupRows& ref = scalar_rows[i];
+      std::string what;
+      if (g.first != ref.first || g.end != ref.end || g.interior_begin != ref.interior_begin ||
+          g.interior_end != ref.interior_end) {
+        std::ostringstream s;
+        s << "rows simd (" << g.first << ", " << g.end << ", " << g.interior_begin << ", "
+          << g.interior_end << "), scalar (" << ref.first << ", " << ref.end << ", "
+          << ref.interior_begin << ", " << ref.interior_end << ")";
+        what = s.str();
+      } else if (same_group(*simd_cols, *scalar_cols, what)) {
+        continue;
+      }
+      if (++differing == 1) {
+        std::ostringstream s;
+        s << describe(sc.setup) << " col " << sc.col << " lanes " << sc.lanes << " rows ["
+          << sc.row_min << ", " << sc.row_max << "): " << what;
+        first = s.str();
+      }
+    }
+    INFO(first);
+    CHECK(differing == 0);
+  }
+  covrast::detail::force_coverage_kernel_target(0);
 }
 
 // ---- Tessellations: coverages add up to exactly one pixel ------------------------------

@@ -23,6 +23,7 @@
 
 #include "geometry/triangle_setup.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace covrast::detail {
@@ -69,7 +70,8 @@ void coverage_rows_simd(const CoverageColumns& columns, int col, int row_begin, 
                         int sign, std::uint16_t* out, std::size_t stride);
 
 /// Highway targets compiled into this build (bit flags, HWY_* values), for tests and
-/// benchmarks; and a way to force one (0 = back to the best supported).
+/// benchmarks; and a way to force one (0 = back to the best supported). Forcing a target
+/// applies to every dispatched function of this header: the kernel and the column set-up.
 std::int64_t coverage_kernel_targets();
 void force_coverage_kernel_target(std::int64_t target);
 const char* coverage_kernel_target_name();
@@ -111,8 +113,26 @@ struct GroupRows {
 
 /// Sets up columns [col, col + kColumnGroup) of `tri` in `columns` (lanes from `lanes` on
 /// get zero width, so the kernel writes 0 there) and returns the group's rows clipped to
-/// [row_min, row_max). The one set-up loop of the coverage mode, its tests and benchmarks.
+/// [row_min, row_max). The one set-up loop of the coverage mode, its tests and benchmarks:
+/// the SIMD set-up for the best target of this CPU (Highway dynamic dispatch, all lanes of
+/// the group at once in double precision), bit-identical to setup_column_group_scalar.
 GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, int row_min,
                              int row_max, CoverageColumns& columns);
+
+/// The scalar twin and reference of setup_column_group: setup_column on each lane, the
+/// same operations in the same order.
+GroupRows setup_column_group_scalar(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                                    int row_max, CoverageColumns& columns);
+
+/// The group's rows from the unclipped union over its columns (first = INT_MAX, end =
+/// INT_MIN when no column is touched): clipped to [row_min, row_max), interior run inside.
+inline GroupRows clip_group_rows(int first, int end, int interior_begin, int interior_end,
+                                 int row_min, int row_max) {
+  GroupRows g{std::max(first, row_min), std::min(end, row_max), 0, 0};
+  if (g.empty()) return GroupRows{0, 0, 0, 0};
+  g.interior_begin = std::clamp(interior_begin, g.first, g.end);
+  g.interior_end = std::clamp(interior_end, g.interior_begin, g.end);
+  return g;
+}
 
 }  // namespace covrast::detail

@@ -1,5 +1,7 @@
 // Raster stage, coverage mode: per-triangle and per-column set-up of the kernel's inputs,
-// in double precision from the snapped vertices; see coverage_kernel.hpp for the formula.
+// in double precision from the snapped vertices (see coverage_kernel.hpp for the formula),
+// and the scalar twins of the SIMD column set-up and kernel (coverage_kernel.cpp), which
+// are the references those must match bit for bit.
 #include "raster/coverage_kernel.hpp"
 
 #include <algorithm>
@@ -24,13 +26,32 @@ CoverageEdge make_edge(double xa, double ya, double xb, double yb) {
 }  // namespace
 
 CoverageTriangle make_coverage_triangle(const TriangleSetup& t) {
-  int order[3] = {0, 1, 2};
-  std::sort(order, order + 3, [&](int i, int j) {
-    return t.x_fx8[i] < t.x_fx8[j] || (t.x_fx8[i] == t.x_fx8[j] && t.y_fx8[i] < t.y_fx8[j]);
-  });
-  const std::int64_t xa = t.x_fx8[order[0]], ya = t.y_fx8[order[0]];
-  const std::int64_t xb = t.x_fx8[order[1]], yb = t.y_fx8[order[1]];
-  const std::int64_t xc = t.x_fx8[order[2]], yc = t.y_fx8[order[2]];
+  // Sort the vertices by x, then y, with a three-comparator network on one int64 key per
+  // vertex: x in the high half, y with its sign bit flipped (order-preserving as unsigned)
+  // in the low half, so the key order is the lexicographic (x, y) order. Vertices with
+  // equal keys are equal, so the order among them does not matter.
+  auto key = [&](int i) {
+    return std::int64_t(std::uint64_t(std::uint32_t(t.x_fx8[i])) << 32 |
+                        (std::uint32_t(t.y_fx8[i]) ^ 0x80000000u));
+  };
+  std::int64_t k0 = key(0), k1 = key(1), k2 = key(2);
+  // Compare-exchange by masked xor: g++ turns a std::min/std::max pair into a branch, which
+  // mispredicts on the random vertex order of a mesh.
+  auto sort2 = [](std::int64_t& lo, std::int64_t& hi) {
+    const std::int64_t flip = (lo ^ hi) & -std::int64_t(hi < lo);
+    lo ^= flip;
+    hi ^= flip;
+  };
+  sort2(k0, k1);
+  sort2(k1, k2);
+  sort2(k0, k1);
+  auto x_of = [](std::int64_t k) { return std::int64_t(std::int32_t(k >> 32)); };
+  auto y_of = [](std::int64_t k) {
+    return std::int64_t(std::int32_t(std::uint32_t(k) ^ 0x80000000u));
+  };
+  const std::int64_t xa = x_of(k0), ya = y_of(k0);
+  const std::int64_t xb = x_of(k1), yb = y_of(k1);
+  const std::int64_t xc = x_of(k2), yc = y_of(k2);
   const double s = 1.0 / kSubpixelOne;
   CoverageTriangle tri;
   tri.edge[0] = make_edge(xa * s, ya * s, xc * s, yc * s);
@@ -85,8 +106,8 @@ ColumnRows setup_column(const CoverageTriangle& tri, int col, CoverageColumns& c
   return rows;
 }
 
-GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, int row_min,
-                             int row_max, CoverageColumns& columns) {
+GroupRows setup_column_group_scalar(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                                    int row_max, CoverageColumns& columns) {
   int first = INT_MAX, end = INT_MIN, interior_begin = INT_MIN, interior_end = INT_MAX;
   for (int lane = 0; lane < kColumnGroup; ++lane) {
     if (lane >= lanes) {
@@ -104,11 +125,7 @@ GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, in
     interior_begin = std::max(interior_begin, rows.interior_begin);
     interior_end = std::min(interior_end, rows.interior_end);
   }
-  GroupRows g{std::max(first, row_min), std::min(end, row_max), 0, 0};
-  if (g.empty()) return GroupRows{0, 0, 0, 0};
-  g.interior_begin = std::clamp(interior_begin, g.first, g.end);
-  g.interior_end = std::clamp(interior_end, g.interior_begin, g.end);
-  return g;
+  return clip_group_rows(first, end, interior_begin, interior_end, row_min, row_max);
 }
 
 void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin, int row_end,
