@@ -930,3 +930,34 @@ TEST_CASE("coverage resolve: the whole-tile path gives what pixel-by-pixel adds 
   CHECK(decided > 300);
   CHECK(undecided > 100);
 }
+
+TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from their lists",
+          "[coverage]") {
+  Scene s = default_like_scene();
+  // Closed, analysed spheres (their back faces are culled, so most of their pixels hold one
+  // layer), overlapping each other and the rest, one with per-triangle colours.
+  auto closed = uv_sphere(24, 48);
+  covrast::analyze_mesh_topology(*closed);
+  const double placements[3][4] = {
+      {-1.5, 0.8, 0.5, 1.2}, {-0.6, 0.4, 1.0, 0.9}, {1.8, -0.9, -0.5, 1.5}};
+  for (const auto& p : placements) {
+    add_instance(s, closed, from_codes(60, 120, 230),
+                 &p == &placements[1] ? ColorSource::PerTriangle : ColorSource::Uniform);
+    s.meshes.back().model = glm::dmat4(glm::dvec4(p[3], 0, 0, 0), glm::dvec4(0, p[3], 0, 0),
+                                       glm::dvec4(0, 0, p[3], 0), glm::dvec4(p[0], p[1], p[2], 1));
+  }
+  for (int tile : {16, 64}) {
+    INFO("tile " << tile);
+    const std::uint64_t before = covrast::detail::abuffer_layer_resolves();
+    const Image with_sums = render(s, ModeKind::Coverage, 2, tile).color;
+    const std::uint64_t used = covrast::detail::abuffer_layer_resolves() - before;
+    covrast::detail::force_abuffer_list_resolve(true);
+    const Image lists_only = render(s, ModeKind::Coverage, 2, tile).color;
+    const std::uint64_t used_forced = covrast::detail::abuffer_layer_resolves() - before - used;
+    covrast::detail::force_abuffer_list_resolve(false);
+    CHECK(used > 1000);       // the sums resolved many pixels...
+    CHECK(used_forced == 0);  // ...and none when forced off
+    REQUIRE(with_sums.rgb.size() == lists_only.rgb.size());
+    CHECK(with_sums.rgb == lists_only.rgb);
+  }
+}

@@ -6,6 +6,7 @@
 #include "raster/shading.hpp"
 #include "resolve/srgb8.hpp"
 
+#include <atomic>
 #include <bit>
 #include <limits>
 
@@ -96,6 +97,14 @@ DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, i
   return DepthOrder::Crossing;
 }
 
+namespace {
+std::atomic<bool> g_list_resolve{false};
+std::atomic<std::uint64_t> g_layer_resolves{0};
+}  // namespace
+
+void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
+std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
+
 ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
   std::size_t n = std::size_t(tile_px) * tile_px;
   opaque_.resize(n);
@@ -103,6 +112,8 @@ ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
   head_.resize(n);
   tail_.resize(n);
   count_.resize(n);
+  layer_.resize(n);
+  layer_sums_.resize(n);
   color_.resize(n);
   depth_.resize(n);
 }
@@ -113,9 +124,22 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   uniform_ = nullptr;
   std::fill(head_.begin(), head_.end(), kEnd);
   std::fill(count_.begin(), count_.end(), 0);
+  std::fill(layer_.begin(), layer_.end(), Layer::Empty);
   pool_.clear();
   merged_slot_.clear();
   merged_.clear();
+}
+
+/// A layer in front of everything else: colour = (sum coverage_i colour_i) / max(sum
+/// coverage_i, 1) + (1 - min(sum coverage_i, 1)) * behind, in 8.8 units; a sum above one
+/// pixel (rounding, or merged pieces) is normalised.
+glm::vec3 ABufferTile::front_layer_color(const LayerSums& sums, glm::vec3 behind) {
+  const std::uint32_t full = kCoverageOne;
+  const double denominator = double(std::max(sums.coverage, full));
+  const double rest = double(full - std::min(sums.coverage, full)) / kCoverageOne;
+  return glm::vec3(float(sums.rgb[0] / denominator + rest * behind.r),
+                   float(sums.rgb[1] / denominator + rest * behind.g),
+                   float(sums.rgb[2] / denominator + rest * behind.b));
 }
 
 void ABufferTile::materialize() {
@@ -251,11 +275,37 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   return true;
 }
 
-void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                               std::uint32_t coverage) {
-  if (count_[pixel] >= kMaxFragmentsPerPixel && handle_overflow(pixel, x, y, t, coverage)) {
+inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                     std::uint32_t coverage, double centre_z) {
+  const std::uint32_t key = t->surface * 2 + (t->front_facing ? 1 : 0);
+  LayerSums& sums = layer_sums_[pixel];
+  if (layer_[pixel] == Layer::Empty) {
+    layer_[pixel] = Layer::One;
+    sums.key = key;
+    sums.coverage = 0;
+    sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
+    sums.depth = std::numeric_limits<float>::infinity();
+  } else if (layer_[pixel] == Layer::Mixed) {
+    return;
+  } else if (sums.key != key || !share_vertex(*t, *pool_[tail_[pixel]].triangle)) {
+    layer_[pixel] = Layer::Mixed;
     return;
   }
+  const glm::vec3 c = shade(*t, x + 0.5, y + 0.5, true);
+  sums.coverage += coverage;
+  sums.rgb[0] += double(coverage) * c.r;
+  sums.rgb[1] += double(coverage) * c.g;
+  sums.rgb[2] += double(coverage) * c.b;
+  sums.depth = std::min(sums.depth, float(centre_z));
+}
+
+void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                               std::uint32_t coverage, double centre_z) {
+  if (count_[pixel] >= kMaxFragmentsPerPixel) {
+    layer_[pixel] = Layer::Mixed;  // merges and drops: only the list knows
+    if (handle_overflow(pixel, x, y, t, coverage)) return;
+  }
+  track_layer(pixel, x, y, t, coverage, centre_z);
   std::uint32_t index = std::uint32_t(pool_.size());
   pool_.push_back(Fragment{t, kEnd, coverage});
   if (head_[pixel] == kEnd) {
@@ -342,14 +392,22 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     if (!in_front[j] && !(front_max < range[j].min)) front_separate = false;
   }
 
-  double weight[kMaxFragmentsPerPixel];
   if (front_separate && (members == n || front_coverage >= std::uint32_t(kCoverageOne))) {
     // One surface in front of everything else in this pixel: its exact areas add, and when
-    // they fill the pixel nothing behind shows. (Weights are normalised below if > 1.)
-    for (int i = 0; i < n; ++i) weight[i] = in_front[i] ? double(cov[i]) / kCoverageOne : 0.0;
-  } else {
-    sample_weights(x, y, opaque, n, tri, cov, merged, weight);
+    // they fill the pixel nothing behind shows.
+    LayerSums sums{0, 0, {0.0, 0.0, 0.0}, depth};
+    for (int i = 0; i < n; ++i) {
+      if (!in_front[i]) continue;
+      const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+      sums.coverage += cov[i];
+      sums.rgb[0] += double(cov[i]) * c.r;
+      sums.rgb[1] += double(cov[i]) * c.g;
+      sums.rgb[2] += double(cov[i]) * c.b;
+    }
+    return front_layer_color(sums, behind);
   }
+  double weight[kMaxFragmentsPerPixel];
+  sample_weights(x, y, opaque, n, tri, cov, merged, weight);
   double total = 0;
   for (int i = 0; i < n; ++i) total += weight[i];
   const double scale = total > 1.0 ? 1.0 / total : 1.0;
@@ -437,12 +495,23 @@ void ABufferTile::resolve(const FrameTarget& target) {
       }
     }
   } else {
+    const bool use_sums = !g_list_resolve.load(std::memory_order_relaxed);
+    std::uint64_t from_sums = 0;
     for (int y = rect_.y0; y < rect_.y1; ++y) {
       for (int x = rect_.x0; x < rect_.x1; ++x) {
         const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+        if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
+          // One layer over the background: what resolve_pixel's front-layer branch gives.
+          const LayerSums& sums = layer_sums_[pixel];
+          color_[pixel] = front_layer_color(sums, target.background_linear);
+          depth_[pixel] = sums.depth;
+          ++from_sums;
+          continue;
+        }
         color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
       }
     }
+    g_layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
   }
   write_tile(target, rect_, color_.data(), depth_.data(), stride_);
 }

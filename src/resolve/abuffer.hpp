@@ -36,6 +36,12 @@ inline constexpr int kMaxFragmentsPerPixel = 32;
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
 
+/// Tests: resolve every pixel from its fragment list, never from the one-layer sums (the
+/// two must give the same bytes).
+void force_abuffer_list_resolve(bool on);
+/// Tests: pixels resolved from the one-layer sums so far, over all tiles and threads.
+std::uint64_t abuffer_layer_resolves();
+
 class ABufferTile {
  public:
   explicit ABufferTile(int tile_px);
@@ -76,8 +82,11 @@ class ABufferTile {
                                          std::size_t pixel, int x, int y) const;
   /// Leaves the whole-tile state: writes the uniform opaque triangle into every pixel.
   void materialize();
-  void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                    std::uint32_t coverage);
+  void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t, std::uint32_t coverage,
+                    double centre_z);
+  /// Keeps the running sums of a pixel whose fragments so far form one layer (see LayerSums).
+  inline void track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                          std::uint32_t coverage, double centre_z);
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
@@ -102,6 +111,21 @@ class ABufferTile {
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
+  /// Per pixel, whether its fragments so far are one layer: all of one mesh instance and
+  /// facing, each sharing a vertex with the one before it (so the layer is connected and its
+  /// pieces do not overlap). Such a pixel with no opaque surface resolves from the sums alone,
+  /// to exactly what the list would give (the front-layer formula of resolve_pixel).
+  enum class Layer : std::uint8_t { Empty, One, Mixed };
+  struct LayerSums {
+    std::uint32_t key;       ///< surface * 2 + front_facing
+    std::uint32_t coverage;  ///< sum of the fragments' 8.8 coverage
+    double rgb[3];           ///< sum of coverage * linear colour, in list order
+    float depth;             ///< nearest centre depth
+  };
+  /// Colour of a layer in front of everything else (abuffer.cpp).
+  static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
+  std::vector<Layer> layer_;
+  std::vector<LayerSums> layer_sums_;
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
   std::vector<MergedPiece> merged_;
@@ -154,7 +178,7 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
         break;  // kept as a fragment, resolved per sample
     }
   }
-  add_fragment(pixel, x, y, t, coverage);
+  add_fragment(pixel, x, y, t, coverage, centre_z);
 }
 
 }  // namespace covrast::detail
