@@ -859,76 +859,52 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
   CHECK(targets.size() >= 1);
 }
 
-TEST_CASE("coverage resolve: the whole-tile path gives what pixel-by-pixel adds give",
+TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by-pixel adds give",
           "[coverage]") {
-  using covrast::detail::ABufferTile;
-  using covrast::detail::FrameTarget;
-  using covrast::detail::kCoverageOne;
-  using covrast::detail::PixelRect;
-  constexpr int kTile = 32;
-  const PixelRect rect{64, 96, 64 + kTile, 96 + kTile};
-  const double cx = 0.5 * (rect.x0 + rect.x1), cy = 0.5 * (rect.y0 + rect.y1);
+  // Large triangles (covering whole tiles and blocks) at nearby, tied and crossing depths,
+  // some with vertex colours, over small ones; rendered with the fast paths and without.
   std::mt19937 rng(2024);
-  std::uniform_real_distribution<double> centre(0.3, 0.7);
-  const double slopes[] = {0.0, 1e-15, -1e-15, 1e-4, -1e-4, 1e-3, -2e-3};
-  int decided = 0, undecided = 0;
-  for (int round = 0; round < 300; ++round) {
-    const int n = 2 + int(rng() % 4);
-    std::vector<TriangleSetup> tris(std::size_t(n), TriangleSetup{});
-    for (int k = 0; k < n; ++k) {
-      TriangleSetup& t = tris[std::size_t(k)];
-      // A large triangle around the tile (positive doubled area, y down).
-      const std::int32_t lo = -1000 * kSubpixelOne, hi = 3000 * kSubpixelOne;
-      t.x_fx8[0] = lo, t.y_fx8[0] = lo;
-      t.x_fx8[1] = hi, t.y_fx8[1] = lo;
-      t.x_fx8[2] = lo, t.y_fx8[2] = hi;
-      t.dzdx = slopes[rng() % std::size(slopes)];
-      t.dzdy = slopes[rng() % std::size(slopes)];
-      double zc = centre(rng);
-      if (k > 0 && rng() % 3 == 0) {
-        // A tie or near tie with the previous plane.
-        const TriangleSetup& p = tris[std::size_t(k - 1)];
-        t.dzdx = p.dzdx;
-        t.dzdy = p.dzdy;
-        zc = p.depth_at(cx, cy) + (rng() % 2 == 0 ? 0.0 : 1e-11);
+  std::uniform_real_distribution<double> coord(-60.0, 220.0), depth(-0.5, 0.5);
+  for (int round = 0; round < 12; ++round) {
+    Scene s = make_scene(160, 120, from_codes(10, 20, 30));
+    const int big = 3 + round % 5;
+    for (int k = 0; k < big; ++k) {
+      std::vector<ScreenVertex> v;
+      const double z = depth(rng);
+      const bool tie = k > 0 && rng() % 3 == 0;  // the same plane as the one before
+      for (int i = 0; i < 3; ++i) {
+        v.push_back({coord(rng), coord(rng), tie ? 0.1 : (rng() % 2 ? z : depth(rng))});
       }
-      t.z0 = zc - t.dzdx * (cx + 1000.0) - t.dzdy * (cy + 1000.0);
-      t.inv_w[0] = t.inv_w[1] = t.inv_w[2] = 1.0f;
-      t.color[0] = t.color[1] = t.color[2] = from_codes(40 * k + 20, 200 - 30 * k, 90 + 25 * k);
-      t.primitive = std::uint32_t(k);
-      t.surface = std::uint32_t(k);
-      t.front_facing = true;
-      t.flat_color = true;
+      std::vector<glm::vec3> colors;
+      if (k % 3 == 2)
+        colors = {from_codes(255, 0, 0), from_codes(0, 255, 0), from_codes(0, 0, 255)};
+      add_instance(s, screen_mesh(s, v, colors), from_codes(40 * k + 20, 200 - 20 * k, 90 + 25 * k),
+                   colors.empty() ? ColorSource::Uniform : ColorSource::Vertex);
     }
-    Image image[2];
-    covrast::DepthImage depth[2];
-    for (int path = 0; path < 2; ++path) {
-      image[path].width = depth[path].width = rect.x1;
-      image[path].height = depth[path].height = rect.y1;
-      image[path].rgb.assign(std::size_t(rect.x1) * rect.y1 * 3, 0);
-      depth[path].depth.assign(std::size_t(rect.x1) * rect.y1, -1.0f);
-      ABufferTile abuffer(kTile);
-      abuffer.begin_tile(rect);
-      for (const TriangleSetup& t : tris) {
-        if (path == 0) {
-          if (abuffer.add_covering_tile(&t)) {
-            ++decided;
-            continue;
-          }
-          ++undecided;
-        }
-        for (int y = rect.y0; y < rect.y1; ++y) {
-          for (int x = rect.x0; x < rect.x1; ++x) abuffer.add(x, y, &t, kCoverageOne);
-        }
-      }
-      abuffer.resolve(FrameTarget{&image[path], &depth[path], from_codes(0, 0, 255)});
+    std::vector<ScreenVertex> small;
+    for (int k = 0; k < 60; ++k) {
+      const double x = coord(rng) * 0.6 + 20, y = coord(rng) * 0.4 + 20, z = depth(rng);
+      small.push_back({x, y, z});
+      small.push_back({x + 7.3, y + 1.1, z});
+      small.push_back({x + 2.2, y + 6.4, z + 0.01});
     }
-    REQUIRE(image[0].rgb == image[1].rgb);
-    REQUIRE(depth[0].depth == depth[1].depth);
+    add_instance(s, screen_mesh(s, small), glm::vec3(1), ColorSource::PerTriangle);
+    for (int tile : {8, 32, 64}) {
+      INFO("round " << round << ", tile " << tile);
+      RenderOptions o;
+      o.mode.kind = ModeKind::Coverage;
+      o.tile = tile;
+      o.threads = 2;
+      o.want_depth = true;
+      const auto fast = covrast::render(s, o);
+      covrast::detail::force_coverage_pixel_path(true);
+      const auto slow = covrast::render(s, o);
+      covrast::detail::force_coverage_pixel_path(false);
+      REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
+      CHECK(fast.color.rgb == slow.color.rgb);
+      CHECK(fast.depth.depth == slow.depth.depth);
+    }
   }
-  // Both branches ran many times: the fast path decided some tiles and left others.
-  CHECK(decided > 300);
-  CHECK(undecided > 100);
 }
 
 TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from their lists",

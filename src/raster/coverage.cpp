@@ -13,6 +13,7 @@
 #include "resolve/srgb8.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <climits>
 #include <limits>
 #include <memory>
@@ -20,6 +21,11 @@
 
 namespace covrast::detail {
 namespace {
+
+std::atomic<bool> g_pixel_path_only{false};
+
+// Aligned column groups lie in one A-buffer block (draw).
+static_assert(kColumnGroup == kAbufferBlockPx);
 
 class CoverageRasterizer final : public TileRasterizer {
  public:
@@ -50,10 +56,18 @@ class CoverageRasterizer final : public TileRasterizer {
   void draw(const TriangleSetup& t) override {
     const PixelRect r = intersect(touched_pixels(t), rect_);
     if (r.empty()) return;
-    if (!blend_ && covers_tile(t) && abuffer_.add_covering_tile(&t)) return;
+    bool skip_decided = false;
+    if (!blend_ && fast_paths_) {
+      if (covers_tile(t) && abuffer_.add_covering_tile(&t)) return;
+      // Only a triangle at least a block wide and high can cover a whole block.
+      if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
+    }
     const CoverageTriangle tri = make_coverage_triangle(t);
     CoverageColumns& cols = *columns_;
-    for (int g = r.x0; g < r.x1; g += kColumnGroup) {
+    // With decided blocks, column groups line up with the blocks, so that a row of a group
+    // lies in one block (columns left of the triangle get zero coverage).
+    const int g0 = skip_decided ? rect_.x0 + (r.x0 - rect_.x0) / kColumnGroup * kColumnGroup : r.x0;
+    for (int g = g0; g < r.x1; g += kColumnGroup) {
       const int lanes = std::min(kColumnGroup, r.x1 - g);
       const GroupRows rows = setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
       if (rows.empty()) continue;
@@ -69,7 +83,7 @@ class CoverageRasterizer final : public TileRasterizer {
       }
       kernel_(cols, 0, interior_end, end, tri.sign,
               plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_, plane_stride_);
-      consume(t, g, lanes, first, end);
+      consume(t, g, lanes, first, end, skip_decided);
     }
   }
 
@@ -93,6 +107,8 @@ class CoverageRasterizer final : public TileRasterizer {
 
   /// Kernel used for the partial runs; tests swap in the scalar twin.
   CoverageRowsFn kernel_ = coverage_rows_simd;
+  /// The whole-tile and whole-block paths; tests turn them off to compare.
+  bool fast_paths_ = !g_pixel_path_only.load(std::memory_order_relaxed);
 
  private:
   /// Whether the triangle covers every pixel of the tile completely: all four corners of
@@ -114,8 +130,10 @@ class CoverageRasterizer final : public TileRasterizer {
   }
 
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
-  void consume(const TriangleSetup& t, int g, int lanes, int first, int end) {
+  void consume(const TriangleSetup& t, int g, int lanes, int first, int end, bool skip_decided) {
     for (int y = first; y < end; ++y) {
+      // Aligned groups: the row lies in one block, decided as a whole.
+      if (skip_decided && abuffer_.block_decided(g, y)) continue;
       const std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
       for (int lane = 0; lane < lanes; ++lane) {
         const std::uint32_t coverage = row[lane];
@@ -151,6 +169,8 @@ class CoverageRasterizer final : public TileRasterizer {
 };
 
 }  // namespace
+
+void force_coverage_pixel_path(bool on) { g_pixel_path_only.store(on); }
 
 std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend) {
   return std::make_unique<CoverageRasterizer>(tile_px, blend);

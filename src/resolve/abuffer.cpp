@@ -105,7 +105,12 @@ std::atomic<std::uint64_t> g_layer_resolves{0};
 void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
 std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
 
-ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
+ABufferTile::ABufferTile(int tile_px)
+    : stride_(tile_px), block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
+  const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);
+  block_uniform_.resize(blocks);
+  block_opaque_.resize(blocks);
+  decided_.resize(blocks);
   std::size_t n = std::size_t(tile_px) * tile_px;
   opaque_.resize(n);
   opaque_z_.resize(n);
@@ -120,8 +125,10 @@ ABufferTile::ABufferTile(int tile_px) : stride_(tile_px) {
 
 void ABufferTile::begin_tile(const PixelRect& rect) {
   rect_ = rect;
-  uniform_valid_ = true;
+  tile_uniform_ = true;
   uniform_ = nullptr;
+  std::fill(decided_.begin(), decided_.end(), 0);
+  decided_stamp_ = 0;
   std::fill(head_.begin(), head_.end(), kEnd);
   std::fill(count_.begin(), count_.end(), 0);
   std::fill(layer_.begin(), layer_.end(), Layer::Empty);
@@ -142,44 +149,94 @@ glm::vec3 ABufferTile::front_layer_color(const LayerSums& sums, glm::vec3 behind
                    float(sums.rgb[2] / denominator + rest * behind.b));
 }
 
-void ABufferTile::materialize() {
-  uniform_valid_ = false;
-  for (int y = rect_.y0; y < rect_.y1; ++y) {
+namespace {
+
+/// How plane `t` lies against plane `u` over every point of `r` (pixel corners included),
+/// from their difference at the rectangle's corners (affine, so extreme there): +1 nearer
+/// everywhere, -1 farther or equal everywhere, 0 undecided. The margin is far above the
+/// rounding of the per-pixel tests, so whenever this decides, ABufferTile::add would have
+/// decided the same at every pixel of `r`.
+int compare_planes(const TriangleSetup& t, const TriangleSetup& u, const PixelRect& r) {
+  constexpr double kMargin = 1e-9;
+  const double xs[2] = {double(r.x0), double(r.x1)};
+  const double ys[2] = {double(r.y0), double(r.y1)};
+  int nearer = 0, farther = 0;
+  for (double y : ys) {
+    for (double x : xs) {
+      const double d = t.depth_at(x, y) - u.depth_at(x, y);
+      nearer += d < -kMargin;
+      farther += d > kMargin;
+    }
+  }
+  return nearer == 4 ? 1 : farther == 4 ? -1 : 0;
+}
+
+}  // namespace
+
+PixelRect ABufferTile::block_rect(std::size_t b) const {
+  const int bx = int(b % std::size_t(block_stride_)), by = int(b / std::size_t(block_stride_));
+  const int x0 = rect_.x0 + bx * kBlockPx, y0 = rect_.y0 + by * kBlockPx;
+  return PixelRect{x0, y0, std::min(x0 + kBlockPx, rect_.x1), std::min(y0 + kBlockPx, rect_.y1)};
+}
+
+void ABufferTile::split_tile() {
+  tile_uniform_ = false;
+  std::fill(block_uniform_.begin(), block_uniform_.end(), 1);
+  std::fill(block_opaque_.begin(), block_opaque_.end(), uniform_);
+}
+
+void ABufferTile::materialize_block(std::size_t b) {
+  block_uniform_[b] = 0;
+  const TriangleSetup* opaque = block_opaque_[b];
+  const PixelRect r = block_rect(b);
+  for (int y = r.y0; y < r.y1; ++y) {
     const std::size_t row = std::size_t(y - rect_.y0) * stride_;
-    for (int x = rect_.x0; x < rect_.x1; ++x) {
-      opaque_[row + (x - rect_.x0)] = uniform_;
+    for (int x = r.x0; x < r.x1; ++x) {
+      opaque_[row + (x - rect_.x0)] = opaque;
       // The centre depth exactly as add() computes it.
-      if (uniform_ != nullptr)
-        opaque_z_[row + (x - rect_.x0)] = uniform_->depth_at(x + 0.5, y + 0.5);
+      if (opaque != nullptr) opaque_z_[row + (x - rect_.x0)] = opaque->depth_at(x + 0.5, y + 0.5);
     }
   }
 }
 
-bool ABufferTile::add_covering_tile(const TriangleSetup* t) {
-  if (!uniform_valid_) return false;
-  if (uniform_ == nullptr) {
-    uniform_ = t;
-    return true;
-  }
-  // The difference of the planes at the tile's corners bounds it at every pixel's corners.
-  // The margin is far above the rounding of the per-pixel tests, so whenever this decides,
-  // add() would have decided the same at every pixel.
-  constexpr double kTileMargin = 1e-9;
-  const double xs[2] = {double(rect_.x0), double(rect_.x1)};
-  const double ys[2] = {double(rect_.y0), double(rect_.y1)};
-  int nearer = 0, farther = 0;
-  for (double y : ys) {
-    for (double x : xs) {
-      const double d = t->depth_at(x, y) - uniform_->depth_at(x, y);
-      nearer += d < -kTileMargin;
-      farther += d > kTileMargin;
+bool ABufferTile::add_covering_blocks(const TriangleSetup& t, const PixelRect& r) {
+  if (tile_uniform_) split_tile();
+  ++decided_stamp_;
+  const TriangleEdges edges(t);
+  const int bx0 = (r.x0 - rect_.x0) / kBlockPx, bx1 = (r.x1 - 1 - rect_.x0) / kBlockPx;
+  const int by0 = (r.y0 - rect_.y0) / kBlockPx, by1 = (r.y1 - 1 - rect_.y0) / kBlockPx;
+  bool any = false;
+  for (int by = by0; by <= by1; ++by) {
+    for (int bx = bx0; bx <= bx1; ++bx) {
+      const std::size_t b = std::size_t(by) * block_stride_ + bx;
+      if (!block_uniform_[b]) continue;
+      const PixelRect br = block_rect(b);
+      // Covered completely: all four corners inside or on every edge (E without the bias).
+      bool inside = true;
+      for (const EdgeFunction& e : edges.e) {
+        for (const std::int64_t y : {std::int64_t(br.y0), std::int64_t(br.y1)}) {
+          for (const std::int64_t x : {std::int64_t(br.x0), std::int64_t(br.x1)}) {
+            inside &= e.at(x * kSubpixelOne, y * kSubpixelOne) - e.bias >= 0;
+          }
+        }
+      }
+      if (!inside) continue;
+      const TriangleSetup* opaque = block_opaque_[b];
+      const int order = opaque == nullptr ? 1 : compare_planes(t, *opaque, br);
+      if (order == 0) continue;
+      if (order > 0) block_opaque_[b] = &t;
+      decided_[b] = decided_stamp_;
+      any = true;
     }
   }
-  if (nearer == 4) {
-    uniform_ = t;
-    return true;
-  }
-  return farther == 4;  // hidden everywhere (equal depth would keep the earlier triangle)
+  return any;
+}
+
+bool ABufferTile::add_covering_tile(const TriangleSetup* t) {
+  if (!tile_uniform_) return false;
+  const int order = uniform_ == nullptr ? 1 : compare_planes(*t, *uniform_, rect_);
+  if (order > 0) uniform_ = t;
+  return order != 0;
 }
 
 void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, std::uint64_t mask,
@@ -481,39 +538,87 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
   }
 }
 
-void ABufferTile::resolve(const FrameTarget& target) {
-  if (uniform_valid_) {
-    // One opaque triangle (or the background) everywhere, as resolve_pixel would give it.
-    for (int y = rect_.y0; y < rect_.y1; ++y) {
-      for (int x = rect_.x0; x < rect_.x1; ++x) {
-        const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-        const double cx = x + 0.5, cy = y + 0.5;
-        color_[pixel] =
-            uniform_ != nullptr ? shade(*uniform_, cx, cy, true) : target.background_linear;
-        depth_[pixel] = uniform_ != nullptr ? float(uniform_->depth_at(cx, cy))
-                                            : std::numeric_limits<float>::infinity();
+void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
+                                       const FrameTarget& target) {
+  if (opaque == nullptr || opaque->flat_color) {
+    // One colour: encode it once and fill; depth as write_tile stores it (at most 1, the
+    // background 1).
+    const glm::vec3 c = opaque != nullptr ? opaque->color[0] : target.background_linear;
+    const std::uint8_t code[3] = {encode_srgb8(c.r), encode_srgb8(c.g), encode_srgb8(c.b)};
+    for (int y = r.y0; y < r.y1; ++y) {
+      std::uint8_t* dst = target.color->pixel(r.x0, y);
+      for (int x = r.x0; x < r.x1; ++x, dst += 3) {
+        dst[0] = code[0];
+        dst[1] = code[1];
+        dst[2] = code[2];
+      }
+      if (target.depth == nullptr) continue;
+      float* depth = &target.depth->depth[std::size_t(y) * target.depth->width + r.x0];
+      for (int x = r.x0; x < r.x1; ++x) {
+        *depth++ =
+            opaque != nullptr ? std::min(float(opaque->depth_at(x + 0.5, y + 0.5)), 1.0f) : 1.0f;
       }
     }
-  } else {
-    const bool use_sums = !g_list_resolve.load(std::memory_order_relaxed);
-    std::uint64_t from_sums = 0;
-    for (int y = rect_.y0; y < rect_.y1; ++y) {
-      for (int x = rect_.x0; x < rect_.x1; ++x) {
-        const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-        if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
-          // One layer over the background: what resolve_pixel's front-layer branch gives.
-          const LayerSums& sums = layer_sums_[pixel];
-          color_[pixel] = front_layer_color(sums, target.background_linear);
-          depth_[pixel] = sums.depth;
-          ++from_sums;
-          continue;
-        }
-        color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
-      }
-    }
-    g_layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
+    return;
   }
-  write_tile(target, rect_, color_.data(), depth_.data(), stride_);
+  for (int y = r.y0; y < r.y1; ++y) {
+    const std::size_t row = std::size_t(y - rect_.y0) * stride_;
+    for (int x = r.x0; x < r.x1; ++x) {
+      const double cx = x + 0.5, cy = y + 0.5;
+      color_[row + (x - rect_.x0)] = shade(*opaque, cx, cy, true);
+      depth_[row + (x - rect_.x0)] = float(opaque->depth_at(cx, cy));
+    }
+  }
+  const std::size_t first = std::size_t(r.y0 - rect_.y0) * stride_ + (r.x0 - rect_.x0);
+  write_tile(target, r, color_.data() + first, depth_.data() + first, stride_);
+}
+
+void ABufferTile::resolve(const FrameTarget& target) {
+  if (tile_uniform_) {
+    resolve_opaque_block(uniform_, rect_, target);
+    return;
+  }
+  const bool use_sums = !g_list_resolve.load(std::memory_order_relaxed);
+  std::uint64_t from_sums = 0;
+  const int block_cols = (rect_.x1 - rect_.x0 + kBlockPx - 1) / kBlockPx;
+  const int block_rows = (rect_.y1 - rect_.y0 + kBlockPx - 1) / kBlockPx;
+  for (int by = 0; by < block_rows; ++by) {
+    for (int bx = 0; bx < block_cols; ++bx) {
+      const std::size_t block = std::size_t(by) * block_stride_ + bx;
+      const PixelRect br = block_rect(block);
+      if (block_uniform_[block]) {
+        resolve_opaque_block(block_opaque_[block], br, target);
+        continue;
+      }
+      for (int y = br.y0; y < br.y1; ++y) {
+        for (int x = br.x0; x < br.x1; ++x) {
+          const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+          if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
+            // One layer over the background: what resolve_pixel's front-layer branch gives.
+            const LayerSums& sums = layer_sums_[pixel];
+            color_[pixel] = front_layer_color(sums, target.background_linear);
+            depth_[pixel] = sums.depth;
+            ++from_sums;
+            continue;
+          }
+          if (head_[pixel] == kEnd) {
+            // No fragments: the opaque surface or the background, as resolve_pixel gives it.
+            const TriangleSetup* opaque = opaque_[pixel];
+            const double cx = x + 0.5, cy = y + 0.5;
+            color_[pixel] =
+                opaque != nullptr ? shade(*opaque, cx, cy, true) : target.background_linear;
+            depth_[pixel] = opaque != nullptr ? float(opaque->depth_at(cx, cy))
+                                              : std::numeric_limits<float>::infinity();
+            continue;
+          }
+          color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
+        }
+      }
+      const std::size_t first = std::size_t(br.y0 - rect_.y0) * stride_ + (br.x0 - rect_.x0);
+      write_tile(target, br, color_.data() + first, depth_.data() + first, stride_);
+    }
+  }
+  g_layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
 }
 
 std::size_t ABufferTile::scratch_bytes() const {

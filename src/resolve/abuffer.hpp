@@ -33,6 +33,9 @@ namespace covrast::detail {
 /// when 32 different surfaces meet in one pixel is the fragment of least area dropped.
 inline constexpr int kMaxFragmentsPerPixel = 32;
 
+/// Block side [pixels] of the A-buffer's block-level fast path.
+inline constexpr int kAbufferBlockPx = 8;
+
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
 
@@ -56,6 +59,11 @@ class ABufferTile {
   /// decide (planes too close or crossing, or the tile is no longer uniform); the caller
   /// then adds the triangle pixel by pixel, which gives what this would have.
   bool add_covering_tile(const TriangleSetup* t);
+  /// The same per block of 8x8 pixels: for every block of the tile that meets `r` and that
+  /// `t` covers completely, while the block still shows one opaque triangle. Returns whether
+  /// any block was decided; the caller skips their pixels (block_decided).
+  bool add_covering_blocks(const TriangleSetup& t, const PixelRect& r);
+  bool block_decided(int x, int y) const { return decided_[block_of(x, y)] == decided_stamp_; }
   /// Resolves every pixel and writes the tile into the frame.
   void resolve(const FrameTarget& target);
 
@@ -80,8 +88,16 @@ class ABufferTile {
 
   inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
                                          std::size_t pixel, int x, int y) const;
-  /// Leaves the whole-tile state: writes the uniform opaque triangle into every pixel.
-  void materialize();
+  static constexpr int kBlockPx = kAbufferBlockPx;
+  std::size_t block_of(int x, int y) const {
+    return std::size_t((y - rect_.y0) / kBlockPx) * block_stride_ + (x - rect_.x0) / kBlockPx;
+  }
+  /// Pixels of block `b`, clipped to the tile.
+  PixelRect block_rect(std::size_t b) const;
+  /// Leaves the whole-tile state: every block shows the tile's uniform triangle.
+  void split_tile();
+  /// Leaves the block state: writes the block's opaque triangle into its pixels.
+  void materialize_block(std::size_t b);
   void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                     double centre_z);
   /// Keeps the running sums of a pixel whose fragments so far form one layer (see LayerSums).
@@ -98,14 +114,24 @@ class ABufferTile {
   void sample_weights(int x, int y, const TriangleSetup* opaque, int n,
                       const TriangleSetup* const* tri, const std::uint32_t* cov,
                       const MergedPiece* const* merged, double* weight) const;
+  /// Writes the pixels `r` that show `opaque` (null: the background) alone into the frame.
+  void resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
+                            const FrameTarget& target);
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
 
   int stride_;
   PixelRect rect_;
-  /// While uniform_valid_: every pixel's opaque triangle is uniform_ (null = background), no
-  /// pixel has fragments, and opaque_ / opaque_z_ are not written yet.
-  bool uniform_valid_ = true;
+  /// While tile_uniform_: every pixel's opaque triangle is uniform_ (null = background), no
+  /// pixel has fragments, and neither the blocks' nor the pixels' state is written.
+  bool tile_uniform_ = true;
   const TriangleSetup* uniform_ = nullptr;
+  /// Per 8x8 block, the same one level down: while block_uniform_, every pixel of the block
+  /// shows block_opaque_ and has no fragments, and its pixel state is not written.
+  int block_stride_;
+  std::vector<std::uint8_t> block_uniform_;
+  std::vector<const TriangleSetup*> block_opaque_;
+  std::vector<std::uint32_t> decided_;  ///< per block, the stamp of the draw that decided it
+  std::uint32_t decided_stamp_ = 0;
   std::vector<const TriangleSetup*> opaque_;  ///< per pixel, null = background
   std::vector<double> opaque_z_;              ///< per pixel, the opaque plane at the centre
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
@@ -153,7 +179,8 @@ inline DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, doub
 }
 
 inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
-  if (uniform_valid_) materialize();
+  if (tile_uniform_) split_tile();
+  if (const std::size_t b = block_of(x, y); block_uniform_[b]) materialize_block(b);
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
   const double centre_z = t->depth_at(x + 0.5, y + 0.5);
   if (opaque_[pixel] == nullptr) {
