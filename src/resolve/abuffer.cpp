@@ -4,6 +4,7 @@
 #include "raster/coverage_kernel.hpp"
 #include "raster/edge_function.hpp"
 #include "raster/shading.hpp"
+#include "resolve/sample_mask.hpp"
 #include "resolve/srgb8.hpp"
 
 #include <atomic>
@@ -51,33 +52,6 @@ bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
     }
   }
   return false;
-}
-
-/// Samples of an 8x8 grid at ((i + 0.5) / 8, (j + 0.5) / 8) inside pixel (x, y), bit
-/// j * 8 + i, that the triangle owns under the top-left rule.
-std::uint64_t sample_mask(const TriangleSetup& t, int x, int y) {
-  TriangleEdges edges(t);
-  constexpr std::int64_t kStep = kSubpixelOne / 8;  // 32 fx8 units
-  const std::int64_t sx = std::int64_t(x) * kSubpixelOne + kStep / 2;
-  const std::int64_t sy = std::int64_t(y) * kSubpixelOne + kStep / 2;
-  std::uint64_t mask = 0;
-  std::int64_t row[3], dx[3], dy[3];
-  for (int e = 0; e < 3; ++e) {
-    row[e] = edges.e[e].at(sx, sy);
-    dx[e] = edges.e[e].step_x(kStep);
-    dy[e] = edges.e[e].step_y(kStep);
-  }
-  for (int j = 0; j < 8; ++j) {
-    std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-    for (int i = 0; i < 8; ++i) {
-      if ((e0 | e1 | e2) >= 0) mask |= std::uint64_t(1) << (j * 8 + i);
-      e0 += dx[0];
-      e1 += dx[1];
-      e2 += dx[2];
-    }
-    for (int e = 0; e < 3; ++e) row[e] += dy[e];
-  }
-  return mask;
 }
 
 }  // namespace
@@ -245,7 +219,7 @@ void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, std::uint6
   if (!(fragment.coverage & kMergedFlag)) {
     if (merged_slot_.size() < pool_.size()) merged_slot_.resize(pool_.size(), kEnd);
     merged_slot_[f] = std::uint32_t(merged_.size());
-    merged_.push_back(MergedPiece{sample_mask(*fragment.triangle, x, y),
+    merged_.push_back(MergedPiece{pixel_sample_mask(*fragment.triangle, x, y),
                                   shade(*fragment.triangle, x + 0.5, y + 0.5, true),
                                   fragment.coverage});
   }
@@ -296,7 +270,8 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     if (same == kEnd) same = f;
   }
   if (same != kEnd) {
-    merge_into(same, coverage, sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x, y);
+    merge_into(same, coverage, pixel_sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x,
+               y);
     return true;
   }
   // 3. Merge two fragments of one surface already in the list, freeing a slot.
@@ -309,7 +284,7 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
         const MergedPiece piece = merged_piece(g);  // a copy: merge_into may grow merged_
         merge_into(f, piece.weight, piece.mask, piece.color, x, y);
       } else {
-        merge_into(f, victim.coverage, sample_mask(*victim.triangle, x, y),
+        merge_into(f, victim.coverage, pixel_sample_mask(*victim.triangle, x, y),
                    shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y);
       }
       pool_[prev].next = victim.next;
@@ -500,7 +475,7 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
   }
   std::uint64_t mask[kMaxFragmentsPerPixel];
   for (int i = 0; i < n; ++i) {
-    mask[i] = merged[i] != nullptr ? merged[i]->mask : sample_mask(*tri[i], x, y);
+    mask[i] = merged[i] != nullptr ? merged[i]->mask : pixel_sample_mask(*tri[i], x, y);
     const std::uint32_t primitive = tri[i]->primitive;
     for (std::uint64_t bits = mask[i]; bits != 0; bits &= bits - 1) {
       const int s = std::countr_zero(bits);

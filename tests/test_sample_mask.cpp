@@ -1,0 +1,397 @@
+// Tests of the 8x8 sub-pixel sample mask of the coverage resolve (src/resolve/sample_mask.hpp):
+// masks computed by hand (ties of the top-left rule on sample columns and rows, a tiny
+// triangle around one sample, two triangles sharing a diagonal through samples), the scalar
+// reference against a direct per-sample evaluation, and every Highway target compiled and
+// supported here against the scalar reference, bit for bit, on 200,000 random
+// (triangle, pixel) pairs.
+#include "geometry/triangle_setup.hpp"
+#include "raster/edge_function.hpp"
+#include "resolve/sample_mask.hpp"
+
+#include <hwy/targets.h>
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace {
+
+using covrast::detail::force_sample_mask_target;
+using covrast::detail::kSubpixelOne;
+using covrast::detail::pixel_sample_mask;
+using covrast::detail::pixel_sample_mask_scalar;
+using covrast::detail::TriangleEdges;
+using covrast::detail::TriangleSetup;
+
+using MaskFn = std::uint64_t (*)(const TriangleSetup&, int, int);
+
+TriangleSetup make_triangle(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1,
+                            std::int32_t x2, std::int32_t y2) {
+  TriangleSetup t{};
+  t.x_fx8[0] = x0;
+  t.y_fx8[0] = y0;
+  t.x_fx8[1] = x1;
+  t.y_fx8[1] = y1;
+  t.x_fx8[2] = x2;
+  t.y_fx8[2] = y2;
+  return t;
+}
+
+/// Position of sample k (0..7) of pixel p along one axis [fx8]: p + (k + 0.5) / 8 pixels.
+constexpr std::int32_t sample_fx8(int p, int k) { return p * kSubpixelOne + 16 + 32 * k; }
+
+/// The mask from the edge functions evaluated at every sample directly (no stepping).
+std::uint64_t direct_mask(const TriangleSetup& t, int x, int y) {
+  const TriangleEdges edges(t);
+  std::uint64_t mask = 0;
+  for (int j = 0; j < 8; ++j) {
+    for (int i = 0; i < 8; ++i) {
+      const std::int64_t px = std::int64_t(x) * kSubpixelOne + 16 + 32 * i;
+      const std::int64_t py = std::int64_t(y) * kSubpixelOne + 16 + 32 * j;
+      bool inside = true;
+      for (const auto& e : edges.e) inside = inside && e.at(px, py) >= 0;
+      if (inside) mask |= std::uint64_t(1) << (j * 8 + i);
+    }
+  }
+  return mask;
+}
+
+/// Edges whose 64 samples in pixel (x, y) are neither all inside nor all outside.
+int crossing_edges(const TriangleSetup& t, int x, int y) {
+  const TriangleEdges edges(t);
+  int crossing = 0;
+  for (const auto& e : edges.e) {
+    int inside = 0;
+    for (int s = 0; s < 64; ++s) {
+      inside += e.at(std::int64_t(x) * kSubpixelOne + 16 + 32 * (s & 7),
+                     std::int64_t(y) * kSubpixelOne + 16 + 32 * (s >> 3)) >= 0;
+    }
+    crossing += inside > 0 && inside < 64;
+  }
+  return crossing;
+}
+
+std::string hex(std::uint64_t v) {
+  char buf[24];
+  std::snprintf(buf, sizeof(buf), "0x%016llx", static_cast<unsigned long long>(v));
+  return buf;
+}
+
+std::string describe(const TriangleSetup& t, int x, int y) {
+  std::ostringstream s;
+  s << "(" << t.x_fx8[0] << ", " << t.y_fx8[0] << ") (" << t.x_fx8[1] << ", " << t.y_fx8[1] << ") ("
+    << t.x_fx8[2] << ", " << t.y_fx8[2] << ") [fx8], pixel (" << x << ", " << y << ")";
+  return s.str();
+}
+
+/// Highway targets compiled into the mask and supported by this CPU, best first. Call before
+/// forcing any target: SupportedTargets() reports the mock once one is set.
+std::vector<std::int64_t> usable_targets() {
+  std::vector<std::int64_t> targets;
+  for (std::int64_t bits = covrast::detail::sample_mask_targets() & hwy::SupportedTargets();
+       bits != 0; bits &= bits - 1) {
+    targets.push_back(bits & -bits);
+  }
+  return targets;
+}
+
+/// Runs `check(name, fn)` with the scalar reference and with pixel_sample_mask forced to
+/// each usable target in turn; restores the best target afterwards.
+void for_each_implementation(const std::function<void(const std::string&, MaskFn)>& check) {
+  const std::vector<std::int64_t> targets = usable_targets();
+  REQUIRE(!targets.empty());
+  check("scalar", pixel_sample_mask_scalar);
+  for (std::int64_t target : targets) {
+    force_sample_mask_target(target);
+    REQUIRE(std::string(covrast::detail::sample_mask_target_name()) == hwy::TargetName(target));
+    check(hwy::TargetName(target), pixel_sample_mask);
+  }
+  force_sample_mask_target(0);
+}
+
+TEST_CASE("sample mask: hand-computed masks and top-left ties", "[coverage]") {
+  // Sample k of a pixel lies at (2k + 1) / 16 along each axis: 1/16, 3/16, ..., 15/16.
+  constexpr std::uint64_t kLeftColumns = 0x0F0F0F0F0F0F0F0Full;   // i = 0..3 in every row
+  constexpr std::uint64_t kRightColumns = 0xF0F0F0F0F0F0F0F0ull;  // i = 4..7
+  constexpr std::uint64_t kTopRows = 0x00000000FFFFFFFFull;       // j = 0..3
+  constexpr std::uint64_t kBottomRows = 0xFFFFFFFF00000000ull;    // j = 4..7
+  constexpr std::int32_t kBig = 32 * kSubpixelOne;                // 32 px
+
+  for_each_implementation([&](const std::string& name, MaskFn mask) {
+    INFO(name);
+    {
+      // Left half of pixel (10, 20), its right edge on the line x = 10.5 (vertical, A -> B
+      // goes down: a right edge, bias -1). x = 0.5 = 8/16 lies between sample columns 3
+      // (7/16) and 4 (9/16): no sample is on the line, the top-left rule has nothing to
+      // decide, and exactly columns 0..3 are inside in all 8 rows.
+      const std::int32_t line = 10 * kSubpixelOne + kSubpixelOne / 2;
+      const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
+      const TriangleSetup left =
+          make_triangle(line, mid - kBig / 2, line, mid + kBig / 2, line - kBig, mid);
+      CHECK(hex(mask(left, 10, 20)) == hex(kLeftColumns));
+      CHECK(mask(left, 9, 20) == ~std::uint64_t(0));  // the whole pixel to the left
+      CHECK(mask(left, 11, 20) == 0);                 // the pixel to the right
+    }
+    {
+      // The line moved to x = 10 + 9/16, through sample column 4. The triangle on the left
+      // has it as a right edge (A -> B downwards, dy > 0: bias -1): the samples on the line
+      // are not its own, it keeps columns 0..3. The triangle on the right shares the edge
+      // as B -> A (upwards, dy < 0: a left edge, bias 0) and owns column 4: columns 4..7.
+      // Each sample exactly once: disjoint, and together the whole pixel.
+      const std::int32_t line = sample_fx8(10, 4);
+      const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
+      const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
+      const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
+      const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
+      CHECK(hex(mask(left, 10, 20)) == hex(kLeftColumns));
+      CHECK(hex(mask(right, 10, 20)) == hex(kRightColumns));
+    }
+    {
+      // A horizontal edge through sample row 4 (y = 20 + 9/16). Below it, the edge runs
+      // A -> B to the right (dy == 0, dx > 0: a top edge, bias 0): the triangle below owns
+      // row 4, rows 4..7. Above, the same edge runs B -> A to the left (not a top edge):
+      // rows 0..3 only.
+      const std::int32_t line = sample_fx8(20, 4);
+      const std::int32_t mid = 10 * kSubpixelOne + kSubpixelOne / 2;
+      const TriangleSetup below =
+          make_triangle(mid - kBig, line, mid + kBig, line, mid, line + kBig);
+      const TriangleSetup above =
+          make_triangle(mid + kBig, line, mid - kBig, line, mid, line - kBig);
+      CHECK(hex(mask(below, 10, 20)) == hex(kBottomRows));
+      CHECK(hex(mask(above, 10, 20)) == hex(kTopRows));
+    }
+    {
+      // A triangle 6 x 5 fx8 units around sample (i, j) = (2, 5) of pixel (-3, 7), far
+      // smaller than the 32-unit sample spacing: that one sample, bit 5 * 8 + 2 = 42.
+      const std::int32_t sx = sample_fx8(-3, 2), sy = sample_fx8(7, 5);
+      const TriangleSetup tiny = make_triangle(sx - 3, sy - 2, sx + 3, sy - 2, sx, sy + 3);
+      CHECK(hex(mask(tiny, -3, 7)) == hex(std::uint64_t(1) << 42));
+      CHECK(mask(tiny, -2, 7) == 0);
+      // The same shape around the pixel centre (8/16, 8/16) lies between samples: no bit.
+      const std::int32_t cx = -3 * kSubpixelOne + 128, cy = 7 * kSubpixelOne + 128;
+      const TriangleSetup between = make_triangle(cx - 3, cy - 2, cx + 3, cy - 2, cx, cy + 3);
+      CHECK(mask(between, -3, 7) == 0);
+    }
+    {
+      // The square [4/16, 12/16]^2 of pixel (5, -2) holds samples i, j = 2..5 (its sides lie
+      // between sample lines): rows 2..5, byte 0x3C each. Split along its diagonal from
+      // (4/16, 4/16) to (12/16, 12/16), which passes through samples (2, 2), (3, 3), (4, 4),
+      // (5, 5). Upper-right triangle (y < x) P0 -> P1 -> P2: the diagonal is P2 -> P0, going
+      // up (dy < 0): a left edge, so it owns the diagonal: rows 2..5 = 0x3C, 0x38, 0x30,
+      // 0x20 (i >= j). Lower-left P0 -> P2 -> P3: the diagonal goes down (dy > 0), not
+      // top-left: rows 3..5 = 0x04, 0x0C, 0x1C (i < j).
+      const std::int32_t x0 = 5 * kSubpixelOne + 64, x1 = 5 * kSubpixelOne + 192;
+      const std::int32_t y0 = -2 * kSubpixelOne + 64, y1 = -2 * kSubpixelOne + 192;
+      const TriangleSetup upper_right = make_triangle(x0, y0, x1, y0, x1, y1);
+      const TriangleSetup lower_left = make_triangle(x0, y0, x1, y1, x0, y1);
+      const std::uint64_t ur = mask(upper_right, 5, -2), ll = mask(lower_left, 5, -2);
+      CHECK(hex(ur) == hex(0x00002030383C0000ull));
+      CHECK(hex(ll) == hex(0x00001C0C04000000ull));
+      CHECK((ur & ll) == 0);
+      CHECK(hex(ur | ll) == hex(0x00003C3C3C3C0000ull));
+    }
+  });
+}
+
+/// Random (triangle, pixel) pairs that stress the exactness: triangles of every size,
+/// slivers, horizontal and vertical edges, vertices on sample positions, pixel borders and
+/// half pixels, coordinates up to +-32768 px; pixels at vertices, on edges, inside the
+/// bounding box and anywhere.
+class CaseGenerator {
+ public:
+  explicit CaseGenerator(std::uint64_t seed) : rng_(seed) {}
+
+  std::int64_t uniform(std::int64_t lo, std::int64_t hi) {
+    return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng_);
+  }
+
+  /// Moves a coordinate onto a lattice now and then: pixel border, sample, half pixel.
+  std::int32_t snap(std::int64_t v) {
+    const std::int64_t pixel = v >> 8;  // floor
+    switch (uniform(0, 5)) {
+      case 0:
+        return std::int32_t(pixel * kSubpixelOne);
+      case 1:
+        return std::int32_t(pixel * kSubpixelOne + 16 + 32 * uniform(0, 7));
+      case 2:
+        return std::int32_t(pixel * kSubpixelOne + 128);
+      default:
+        return std::int32_t(v);
+    }
+  }
+
+  /// A triangle whose vertices lie within +-range_fx8.
+  TriangleSetup triangle(std::int64_t range_fx8) {
+    const std::int64_t cx = uniform(-range_fx8, range_fx8), cy = uniform(-range_fx8, range_fx8);
+    const std::int64_t sizes[] = {8, 40, 256, 1024, 16384, std::int64_t(1) << 20, range_fx8};
+    const std::int64_t r = sizes[uniform(0, 6)];
+    std::int64_t v[6];
+    switch (uniform(0, 3)) {
+      case 0: {  // anything of size r
+        for (int k = 0; k < 3; ++k) {
+          v[2 * k] = snap(cx + uniform(-r, r));
+          v[2 * k + 1] = snap(cy + uniform(-r, r));
+        }
+        break;
+      }
+      case 1: {  // sliver: c close to the segment ab
+        const std::int64_t ax = cx, ay = cy;
+        const std::int64_t bx = cx + uniform(-r, r), by = cy + uniform(-r, r);
+        const std::int64_t t = uniform(0, 1024);
+        v[0] = snap(ax);
+        v[1] = snap(ay);
+        v[2] = snap(bx);
+        v[3] = snap(by);
+        v[4] = ax + (bx - ax) * t / 1024 + uniform(-3, 3);
+        v[5] = ay + (by - ay) * t / 1024 + uniform(-3, 3);
+        break;
+      }
+      default: {  // right triangle with a horizontal and a vertical edge
+        const std::int64_t x = snap(cx), y = snap(cy);
+        std::int64_t w = uniform(-r, r), h = uniform(-r, r);
+        if (uniform(0, 1) == 0) {  // on the sample or pixel lattice
+          const std::int64_t unit = uniform(0, 1) == 0 ? 32 : kSubpixelOne;
+          w = w / unit * unit;
+          h = h / unit * unit;
+        }
+        const std::int64_t corner[6] = {x, y, x + w, y, x, y + h};
+        std::copy(corner, corner + 6, v);
+        break;
+      }
+    }
+    for (std::int64_t& c : v) c = std::clamp(c, -range_fx8, range_fx8);
+    // Positive doubled area as the setup makes it; a few of either orientation kept.
+    const std::int64_t area2 = (v[2] - v[0]) * (v[5] - v[1]) - (v[4] - v[0]) * (v[3] - v[1]);
+    if (area2 < 0 && uniform(0, 49) != 0) {
+      std::swap(v[2], v[4]);
+      std::swap(v[3], v[5]);
+    }
+    return make_triangle(std::int32_t(v[0]), std::int32_t(v[1]), std::int32_t(v[2]),
+                         std::int32_t(v[3]), std::int32_t(v[4]), std::int32_t(v[5]));
+  }
+
+  /// A pixel for `t`: kind 0 at a vertex (or next to it), 1 on an edge, 2 in the bounding
+  /// box, 3 anywhere within +-range_px.
+  std::pair<int, int> pixel(const TriangleSetup& t, int kind, std::int64_t range_px) {
+    switch (kind) {
+      case 0: {
+        const int k = int(uniform(0, 2));
+        const int dx = uniform(0, 3) == 0 ? int(uniform(-1, 1)) : 0;
+        const int dy = uniform(0, 3) == 0 ? int(uniform(-1, 1)) : 0;
+        return {(t.x_fx8[k] >> 8) + dx, (t.y_fx8[k] >> 8) + dy};
+      }
+      case 1: {
+        const int a = int(uniform(0, 2)), b = (a + 1) % 3;
+        const std::int64_t s = uniform(0, 1 << 16);
+        const std::int64_t px = t.x_fx8[a] + (std::int64_t(t.x_fx8[b]) - t.x_fx8[a]) * s / 65536;
+        const std::int64_t py = t.y_fx8[a] + (std::int64_t(t.y_fx8[b]) - t.y_fx8[a]) * s / 65536;
+        return {int(px >> 8), int(py >> 8)};
+      }
+      case 2: {
+        const auto [x0, x1] = std::minmax({t.x_fx8[0], t.x_fx8[1], t.x_fx8[2]});
+        const auto [y0, y1] = std::minmax({t.y_fx8[0], t.y_fx8[1], t.y_fx8[2]});
+        return {int(uniform(x0 >> 8, x1 >> 8)), int(uniform(y0 >> 8, y1 >> 8))};
+      }
+      default:
+        return {int(uniform(-range_px, range_px)), int(uniform(-range_px, range_px))};
+    }
+  }
+
+ private:
+  std::mt19937_64 rng_;
+};
+
+struct Case {
+  TriangleSetup t;
+  int x, y;
+};
+
+TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[coverage]") {
+  // +-32768 px: an image side of 16384 px plus the 16384 px guard band on either side.
+  constexpr std::int64_t kRangePx = 32768;
+  constexpr int kTriangles = 50000, kPixelsPerTriangle = 4;
+  CaseGenerator gen(0x5a3b1e0fu);
+  std::vector<Case> cases;
+  cases.reserve(std::size_t(kTriangles) * kPixelsPerTriangle + 8000);
+  for (int n = 0; n < kTriangles; ++n) {
+    const TriangleSetup t = gen.triangle(kRangePx * kSubpixelOne);
+    for (int k = 0; k < kPixelsPerTriangle; ++k) {
+      const auto [x, y] = gen.pixel(t, k, kRangePx);
+      cases.push_back({t, x, y});
+    }
+  }
+  // Edges too long for the int32 lanes (vertices up to +-2^29 fx8, far beyond the guard
+  // band): they take the scalar path and must still agree.
+  const std::size_t wide_begin = cases.size();
+  for (int n = 0; n < 2000; ++n) {
+    const TriangleSetup t = gen.triangle(std::int64_t(1) << 29);
+    for (int k = 0; k < kPixelsPerTriangle; ++k) {
+      const auto [x, y] = gen.pixel(t, k % 2, 0);
+      cases.push_back({t, x, y});
+    }
+  }
+  REQUIRE(cases.size() >= 200000);
+
+  // The reference against a direct evaluation at each sample, and what the cases exercise:
+  // how many edges cross the sample grid (the SIMD lanes run only for crossing edges).
+  std::vector<std::uint64_t> reference(cases.size());
+  std::size_t direct_mismatch = 0, partial = 0, full = 0, empty = 0;
+  std::size_t by_crossing[4] = {};
+  std::string first_direct;
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    const Case& k = cases[c];
+    reference[c] = pixel_sample_mask_scalar(k.t, k.x, k.y);
+    if (reference[c] != direct_mask(k.t, k.x, k.y) && direct_mismatch++ == 0) {
+      first_direct = describe(k.t, k.x, k.y);
+    }
+    if (c >= wide_begin) continue;
+    ++by_crossing[crossing_edges(k.t, k.x, k.y)];
+    if (reference[c] == 0) {
+      ++empty;
+    } else if (reference[c] == ~std::uint64_t(0)) {
+      ++full;
+    } else {
+      ++partial;
+    }
+  }
+  INFO(first_direct);
+  CHECK(direct_mismatch == 0);
+  INFO("crossing edges 0/1/2/3: " << by_crossing[0] << " " << by_crossing[1] << " "
+                                  << by_crossing[2] << " " << by_crossing[3] << "; masks empty "
+                                  << empty << ", full " << full << ", partial " << partial);
+  CHECK(by_crossing[1] > 20000);
+  CHECK(by_crossing[2] > 5000);
+  CHECK(by_crossing[3] > 2000);
+  CHECK(partial > 50000);
+  CHECK(full > 2000);
+  CHECK(empty > 20000);
+
+  std::string names;
+  for (std::int64_t t : usable_targets()) names += std::string(hwy::TargetName(t)) + " ";
+  WARN("sample mask targets compiled and supported here: " << names);
+  for_each_implementation([&](const std::string& name, MaskFn mask) {
+    INFO(name);
+    std::size_t mismatch = 0;
+    std::string first;
+    for (std::size_t c = 0; c < cases.size(); ++c) {
+      const Case& k = cases[c];
+      const std::uint64_t got = mask(k.t, k.x, k.y);
+      if (got != reference[c] && mismatch++ == 0) {
+        first = describe(k.t, k.x, k.y) + ": " + hex(got) + ", scalar " + hex(reference[c]);
+      }
+    }
+    INFO(first);
+    CHECK(mismatch == 0);
+  });
+  CHECK(pixel_sample_mask(cases[0].t, cases[0].x, cases[0].y) == reference[0]);
+}
+
+}  // namespace
