@@ -345,7 +345,22 @@ bool same_rgb(const std::uint8_t* p, const std::uint8_t* q) {
 
 // ---- 3. Tessellations through the renderer --------------------------------------------------
 
+namespace {
+
+/// A-buffers made while it lives keep at most `fragments` per pixel, so that small scenes
+/// reach the overflow policy (the product's limit, kMaxFragmentsPerPixel, is larger).
+struct FragmentCapacity {
+  explicit FragmentCapacity(int fragments) { covrast::detail::force_abuffer_capacity(fragments); }
+  ~FragmentCapacity() { covrast::detail::force_abuffer_capacity(0); }
+  FragmentCapacity(const FragmentCapacity&) = delete;
+  FragmentCapacity& operator=(const FragmentCapacity&) = delete;
+};
+constexpr int kTestCapacity = 32;
+
+}  // namespace
+
 TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
+  const FragmentCapacity capacity(kTestCapacity);
   enum class Behind { Nothing, QuadFirst, QuadLast, LayerFirst, LayerLast };
   struct Case {
     int codes_c[3], codes_b[3];
@@ -354,8 +369,8 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
   };
   // Dark on white is the most sensitive to background leaking through (sRGB is steep near
   // 0: at code 0, a leak of 0.00015 of white already shows); cells of 0.4 px overflow the
-  // A-buffer's fragment lists (more than 16 triangles per pixel). The surface behind is a
-  // quad larger than the square, or a second tessellated square (cells of 0.53 px).
+  // A-buffer's fragment lists (more than kTestCapacity triangles per pixel). The surface behind is
+  // a quad larger than the square, or a second tessellated square (cells of 0.53 px).
   const Case cases[] = {{{0, 0, 0}, {255, 255, 255}, 24, Behind::Nothing},
                         {{200, 30, 90}, {10, 250, 128}, 24, Behind::Nothing},
                         {{0, 0, 0}, {255, 255, 255}, 400, Behind::Nothing},
@@ -499,10 +514,11 @@ TEST_CASE("coverage mode: a closed mesh renders as one flat colour", "[coverage]
   }
 }
 
-// Near the poles of the sphere more than kMaxFragmentsPerPixel triangles, front and
+// Near the poles of the sphere more than kTestCapacity triangles, front and
 // back faces, touch one outline pixel: this exercises the overflow merge (masks united) on
 // the per-sample path. (It once failed by 29/255 when merges dropped the masks.)
 TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage]") {
+  const FragmentCapacity capacity(kTestCapacity);
   // Front and back faces meet at the outline: two layers of one surface, resolved on the
   // sub-pixel masks there.
   const Scene s = sphere_scene(from_codes(180, 95, 40), from_codes(0, 0, 0));
@@ -529,7 +545,7 @@ TEST_CASE("coverage mode: a sphere's outline matches the reference", "[coverage]
 
 TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[coverage]") {
   // The control of the case above: the same sphere with the faces turned away from the eye
-  // removed (fewer than 16 fragments per pixel everywhere).
+  // removed (no pixel overflows its list).
   Scene s = sphere_scene(from_codes(180, 95, 40), from_codes(0, 0, 0));
   auto mesh = std::make_shared<MeshData>(*s.meshes[0].mesh);
   std::vector<std::uint32_t> front;
@@ -557,16 +573,16 @@ TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[c
   CHECK(c.mean_diff8 < 0.01);
 }
 
-// A fan of kMaxFragmentsPerPixel + 8 slivers of one mesh meets at (20.25, 20.5), covering x < 20.25
+// A fan of kTestCapacity + 8 slivers of one mesh meets at (20.25, 20.5), covering x < 20.25
 // of pixel (20, 20) (a quarter); a triangle of another mesh behind covers x < 20.6 of that pixel.
 // All 25 touch the pixel. Expected (linear): red 0.25, blue 0.35, black 0.4. Overflow must neither
 // drop the farther triangle nor lose the merged slivers' sample masks.
-TEST_CASE("coverage mode: more than 16 fragments in a pixel keep their places", "[coverage]") {
+TEST_CASE("coverage mode: more fragments than a pixel list holds keep their places", "[coverage]") {
   for (bool back_first : {false, true}) {
     Scene s = make_scene(40, 40, glm::vec3(0));
     std::vector<ScreenVertex> fan;
-    constexpr int kSpokes =
-        covrast::detail::kMaxFragmentsPerPixel + 8;  // enough to overflow the list
+    const FragmentCapacity capacity(kTestCapacity);
+    constexpr int kSpokes = kTestCapacity + 8;  // enough to overflow the list
     for (int k = 0; k < kSpokes; ++k) {
       const double a0 = kPi / 2 + kPi * k / kSpokes, a1 = kPi / 2 + kPi * (k + 1) / kSpokes;
       fan.push_back({20.25, 20.5, 0.5});

@@ -7,6 +7,7 @@
 #include "resolve/sample_mask.hpp"
 #include "resolve/srgb8.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <bit>
 #include <limits>
@@ -54,6 +55,24 @@ bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
   return false;
 }
 
+/// A triangle's depth over pixel (x, y), from its centre: z(centre) -+ (|dz/dx| + |dz/dy|) / 2.
+DepthRange pixel_depth_range(const TriangleSetup& t, int x, int y) {
+  const double centre_z = t.depth_at(x + 0.5, y + 0.5);
+  const double reach = 0.5 * (std::fabs(t.dzdx) + std::fabs(t.dzdy));
+  return DepthRange{centre_z - reach, centre_z + reach};
+}
+
+/// Whether two fragments are pieces of one layer of a surface: same mesh instance and facing,
+/// and sharing a vertex; a merged fragment stands for several adjacent pieces (merges keep to
+/// one layer, see handle_overflow), so it joins any fragment of its surface that overlaps it
+/// in depth.
+bool layer_neighbours(const TriangleSetup& a, bool a_merged, DepthRange ra, const TriangleSetup& b,
+                      bool b_merged, DepthRange rb) {
+  if (!same_surface(a, b)) return false;
+  if (share_vertex(a, b)) return true;
+  return (a_merged || b_merged) && !(ra.max < rb.min || rb.max < ra.min);
+}
+
 }  // namespace
 
 /// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
@@ -74,13 +93,21 @@ DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, i
 namespace {
 std::atomic<bool> g_list_resolve{false};
 std::atomic<std::uint64_t> g_layer_resolves{0};
+std::atomic<int> g_capacity{kMaxFragmentsPerPixel};
 }  // namespace
+
+void force_abuffer_capacity(int fragments) {
+  g_capacity.store(fragments <= 0 ? kMaxFragmentsPerPixel
+                                  : std::clamp(fragments, 2, kMaxFragmentsPerPixel));
+}
 
 void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
 std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
 
 ABufferTile::ABufferTile(int tile_px)
-    : stride_(tile_px), block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
+    : stride_(tile_px),
+      capacity_(g_capacity.load()),
+      block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
   const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);
   block_uniform_.resize(blocks);
   block_opaque_.resize(blocks);
@@ -238,71 +265,137 @@ void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, std::uint6
 bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                   std::uint32_t coverage) {
   ++overflows_;
-  // 1. Drop fragments that the opaque surface now hides everywhere.
+  std::uint32_t id[kMaxFragmentsPerPixel];
+  DepthRange range[kMaxFragmentsPerPixel];
+  bool keep[kMaxFragmentsPerPixel];
+  int n = 0;
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next, ++n) {
+    id[n] = f;
+    range[n] = pixel_depth_range(*pool_[f].triangle, x, y);
+    keep[n] = true;
+  }
+  auto tri = [&](int i) -> const TriangleSetup& { return *pool_[id[i]].triangle; };
+  auto merged = [&](int i) { return (pool_[id[i]].coverage & kMergedFlag) != 0; };
+  auto value = [&](int i) { return pool_[id[i]].coverage & ~kMergedFlag; };
+  // 1. Drop fragments that the opaque surface hides everywhere.
   if (const TriangleSetup* opaque = opaque_[pixel]; opaque != nullptr) {
-    std::uint32_t kept = kEnd, last = kEnd;
-    int n = 0;
-    for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-      if (order_of(*pool_[f].triangle, *opaque, x, y) == DepthOrder::Behind) continue;
-      if (last == kEnd) {
-        kept = f;
-      } else {
-        pool_[last].next = f;
+    for (int i = 0; i < n; ++i) keep[i] = order_of(tri(i), *opaque, x, y) != DepthOrder::Behind;
+  }
+  // 2. Drop fragments wholly behind a layer that fills the pixel: the nearest fragment's
+  //    connected pieces of one surface (as in resolve_pixel), when their areas add to one.
+  int nearest = -1;
+  for (int i = 0; i < n; ++i) {
+    if (keep[i] && (nearest < 0 || range[i].min < range[nearest].min)) nearest = i;
+  }
+  if (nearest >= 0) {
+    bool in_layer[kMaxFragmentsPerPixel] = {};
+    int stack[kMaxFragmentsPerPixel], top = 0;
+    in_layer[nearest] = true;
+    stack[top++] = nearest;
+    std::uint32_t layer_coverage = value(nearest);
+    double layer_max = range[nearest].max;
+    while (top > 0) {
+      const int m = stack[--top];
+      for (int j = 0; j < n; ++j) {
+        if (!keep[j] || in_layer[j] ||
+            !layer_neighbours(tri(m), merged(m), range[m], tri(j), merged(j), range[j])) {
+          continue;
+        }
+        in_layer[j] = true;
+        stack[top++] = j;
+        layer_coverage += value(j);
+        layer_max = std::max(layer_max, range[j].max);
       }
-      last = f;
-      ++n;
+    }
+    if (layer_coverage >= std::uint32_t(kCoverageOne)) {
+      for (int i = 0; i < n; ++i) {
+        if (keep[i] && !in_layer[i] && range[i].min > layer_max) keep[i] = false;
+      }
+    }
+  }
+  int kept = 0;
+  for (int i = 0; i < n; ++i) kept += keep[i];
+  if (kept < n) {
+    std::uint32_t last = kEnd;
+    head_[pixel] = kEnd;
+    for (int i = 0; i < n; ++i) {
+      if (!keep[i]) continue;
+      if (last == kEnd) {
+        head_[pixel] = id[i];
+      } else {
+        pool_[last].next = id[i];
+      }
+      last = id[i];
     }
     if (last != kEnd) pool_[last].next = kEnd;
-    head_[pixel] = kept;
     tail_[pixel] = last;
-    count_[pixel] = std::uint8_t(n);
-    if (n < kMaxFragmentsPerPixel) return false;
+    count_[pixel] = std::uint8_t(kept);
+    if (kept < capacity_) return false;
   }
-  // 2. Merge the new fragment into an adjacent fragment of its surface, else any of it.
-  std::uint32_t same = kEnd;
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    const TriangleSetup& o = *pool_[f].triangle;
-    if (!same_surface(o, *t)) continue;
-    if (share_vertex(o, *t)) {
-      same = f;
-      break;
+  // 3. Merge the new fragment into a fragment of its surface and facing: one sharing a vertex
+  //    with it, else the one nearest in depth (pieces of one layer, not of a fold behind).
+  const DepthRange new_range = pixel_depth_range(*t, x, y);
+  auto gap = [](DepthRange a, DepthRange b) {
+    return std::max(0.0, std::max(a.min, b.min) - std::min(a.max, b.max));
+  };
+  int into = -1;
+  double best_gap = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (!same_surface(tri(i), *t)) continue;
+    const double g = share_vertex(tri(i), *t) ? -1.0 : gap(range[i], new_range);
+    if (into < 0 || g < best_gap) {
+      into = i;
+      best_gap = g;
     }
-    if (same == kEnd) same = f;
   }
-  if (same != kEnd) {
-    merge_into(same, coverage, pixel_sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true), x,
-               y);
+  if (into >= 0) {
+    merge_into(id[into], coverage, pixel_sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true),
+               x, y);
     return true;
   }
-  // 3. Merge two fragments of one surface already in the list, freeing a slot.
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    std::uint32_t prev = f;
-    for (std::uint32_t g = pool_[f].next; g != kEnd; prev = g, g = pool_[g].next) {
-      if (!same_surface(*pool_[f].triangle, *pool_[g].triangle)) continue;
-      const Fragment victim = pool_[g];
-      if (victim.coverage & kMergedFlag) {
-        const MergedPiece piece = merged_piece(g);  // a copy: merge_into may grow merged_
-        merge_into(f, piece.weight, piece.mask, piece.color, x, y);
-      } else {
-        merge_into(f, victim.coverage, pixel_sample_mask(*victim.triangle, x, y),
-                   shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y);
+  // 4. Merge two fragments of one surface and facing already in the list, freeing a slot:
+  //    a pair sharing a vertex, else the pair nearest in depth.
+  int keep_i = -1, drop_j = -1;
+  best_gap = 0.0;
+  for (int i = 0; i < n; ++i) {
+    for (int j = i + 1; j < n; ++j) {
+      if (!same_surface(tri(i), tri(j))) continue;
+      const double g = share_vertex(tri(i), tri(j)) ? -1.0 : gap(range[i], range[j]);
+      if (keep_i < 0 || g < best_gap) {
+        keep_i = i;
+        drop_j = j;
+        best_gap = g;
       }
+    }
+  }
+  if (keep_i >= 0) {
+    const Fragment victim = pool_[id[drop_j]];
+    if (victim.coverage & kMergedFlag) {
+      const MergedPiece piece = merged_piece(id[drop_j]);  // a copy: merge_into may grow merged_
+      merge_into(id[keep_i], piece.weight, piece.mask, piece.color, x, y);
+    } else {
+      merge_into(id[keep_i], victim.coverage, pixel_sample_mask(*victim.triangle, x, y),
+                 shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y);
+    }
+    // Unlink the victim.
+    const std::uint32_t prev = drop_j > 0 ? id[drop_j - 1] : kEnd;
+    if (prev == kEnd) {
+      head_[pixel] = victim.next;
+    } else {
       pool_[prev].next = victim.next;
-      if (tail_[pixel] == g) tail_[pixel] = prev;
-      --count_[pixel];
-      return false;
     }
+    if (tail_[pixel] == id[drop_j]) tail_[pixel] = prev;
+    --count_[pixel];
+    return false;
   }
-  // 4. Many different surfaces in one pixel: keep the larger areas.
-  std::uint32_t smallest = head_[pixel];
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    if ((pool_[f].coverage & ~kMergedFlag) < (pool_[smallest].coverage & ~kMergedFlag)) {
-      smallest = f;
-    }
+  // 5. Many different surfaces in one pixel: keep the larger areas.
+  int smallest = 0;
+  for (int i = 1; i < n; ++i) {
+    if (value(i) < value(smallest)) smallest = i;
   }
-  if (coverage > (pool_[smallest].coverage & ~kMergedFlag)) {
-    pool_[smallest].triangle = t;
-    pool_[smallest].coverage = coverage;
+  if (coverage > value(smallest)) {
+    pool_[id[smallest]].triangle = t;
+    pool_[id[smallest]].coverage = coverage;
   }
   return true;
 }
@@ -333,7 +426,7 @@ inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const Tria
 
 void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                std::uint32_t coverage, double centre_z) {
-  if (count_[pixel] >= kMaxFragmentsPerPixel) {
+  if (count_[pixel] >= capacity_) {
     layer_[pixel] = Layer::Mixed;  // merges and drops: only the list knows
     if (handle_overflow(pixel, x, y, t, coverage)) return;
   }
@@ -394,8 +487,8 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   // fragment already stands for adjacent pieces of its surface). Its pieces do not
   // overlap, so their exact areas add.
   auto connected = [&](int i, int j) {
-    return same_surface(*tri[i], *tri[j]) &&
-           (merged[i] != nullptr || merged[j] != nullptr || share_vertex(*tri[i], *tri[j]));
+    return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
+                            range[j]);
   };
   int nearest = 0;
   for (int i = 1; i < n; ++i) {

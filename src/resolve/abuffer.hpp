@@ -26,12 +26,15 @@
 
 namespace covrast::detail {
 
-/// Fragments one pixel keeps. Beyond it (counted in overflow_count()): drop fragments the
-/// opaque surface hides; else merge the new fragment into one of the same surface and facing
-/// (preferably an adjacent one): areas add, sample masks are united, the older triangle's
-/// plane and colour stand for both; else merge two such fragments already in the list; only
-/// when 32 different surfaces meet in one pixel is the fragment of least area dropped.
-inline constexpr int kMaxFragmentsPerPixel = 32;
+/// Fragments one pixel keeps (sub-pixel triangles of dense meshes put dozens in a pixel; at
+/// 32 the Stanford bunny at 640x360 overflowed 6,000 times, at 128 never). Beyond it (counted
+/// in overflow_count()): drop fragments the opaque surface hides, and those wholly behind a
+/// layer of one surface that fills the pixel; else merge the new fragment into one of the same
+/// surface and facing, sharing a vertex with it or else nearest in depth (so that a fold behind
+/// is not mixed in): areas add, sample masks are united, the older triangle's plane and colour
+/// stand for both; else merge two such fragments already in the list; only when 128 different
+/// surfaces meet in one pixel is the fragment of least area dropped.
+inline constexpr int kMaxFragmentsPerPixel = 128;
 
 /// Block side [pixels] of the A-buffer's block-level fast path.
 inline constexpr int kAbufferBlockPx = 8;
@@ -42,6 +45,9 @@ enum class DepthOrder { InFront, Behind, Crossing };
 /// Tests: resolve every pixel from its fragment list, never from the one-layer sums (the
 /// two must give the same bytes).
 void force_abuffer_list_resolve(bool on);
+/// Tests: A-buffers made from now on keep at most `fragments` per pixel (0: back to
+/// kMaxFragmentsPerPixel), so that the overflow policy can be exercised on small scenes.
+void force_abuffer_capacity(int fragments);
 /// Tests: pixels resolved from the one-layer sums so far, over all tiles and threads.
 std::uint64_t abuffer_layer_resolves();
 
@@ -120,6 +126,7 @@ class ABufferTile {
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
 
   int stride_;
+  int capacity_;  ///< fragments per pixel before the overflow policy, <= kMaxFragmentsPerPixel
   PixelRect rect_;
   /// While tile_uniform_: every pixel's opaque triangle is uniform_ (null = background), no
   /// pixel has fragments, and neither the blocks' nor the pixels' state is written.
