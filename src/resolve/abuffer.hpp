@@ -56,7 +56,11 @@ class ABufferTile {
   explicit ABufferTile(int tile_px);
 
   void begin_tile(const PixelRect& rect);
-  /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile.
+  /// Makes pixels [x0, x1) of row y ready for add() (at most two blocks: x1 - x0 <= 8):
+  /// leaves the whole-tile state and writes out the state of uniform blocks.
+  inline void prepare_row(int x0, int x1, int y);
+  /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile, which
+  /// prepare_row() has made ready.
   inline void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage);
   /// Whole-tile fast path for a triangle that covers every pixel of the tile: while every
   /// pixel still shows one opaque triangle (or the background) and nothing else, the new
@@ -185,9 +189,13 @@ inline DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, doub
   return order_of(t, o, x, y);
 }
 
-inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
+inline void ABufferTile::prepare_row(int x0, int x1, int y) {
   if (tile_uniform_) split_tile();
-  if (const std::size_t b = block_of(x, y); block_uniform_[b]) materialize_block(b);
+  if (const std::size_t b = block_of(x0, y); block_uniform_[b]) materialize_block(b);
+  if (const std::size_t b = block_of(x1 - 1, y); block_uniform_[b]) materialize_block(b);
+}
+
+inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
   const double centre_z = t->depth_at(x + 0.5, y + 0.5);
   if (opaque_[pixel] == nullptr) {
