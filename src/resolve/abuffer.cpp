@@ -130,9 +130,6 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   uniform_ = nullptr;
   std::fill(decided_.begin(), decided_.end(), 0);
   decided_stamp_ = 0;
-  std::fill(head_.begin(), head_.end(), kEnd);
-  std::fill(count_.begin(), count_.end(), 0);
-  std::fill(layer_.begin(), layer_.end(), Layer::Empty);
   pool_.clear();
   merged_slot_.clear();
   merged_.clear();
@@ -193,9 +190,15 @@ void ABufferTile::materialize_block(std::size_t b) {
   for (int y = r.y0; y < r.y1; ++y) {
     const std::size_t row = std::size_t(y - rect_.y0) * stride_;
     for (int x = r.x0; x < r.x1; ++x) {
-      opaque_[row + (x - rect_.x0)] = opaque;
+      const std::size_t pixel = row + (x - rect_.x0);
+      opaque_[pixel] = opaque;
       // The centre depth exactly as add() computes it.
-      if (opaque != nullptr) opaque_z_[row + (x - rect_.x0)] = opaque->depth_at(x + 0.5, y + 0.5);
+      if (opaque != nullptr) opaque_z_[pixel] = opaque->depth_at(x + 0.5, y + 0.5);
+      // The per-pixel lists start here (not at begin_tile): blocks that stay uniform never
+      // touch them.
+      head_[pixel] = kEnd;
+      count_[pixel] = 0;
+      layer_[pixel] = Layer::Empty;
     }
   }
 }
