@@ -24,6 +24,13 @@ using ClipPlane = glm::dvec4;
 /// Outcode bits of the near and far planes (planes_[0] and planes_[1]).
 constexpr unsigned kNearFarBits = 1u << 0 | 1u << 1;
 
+/// A model-space position in clip space. The one expression for it: transform_vertices and
+/// clip_triangle both use it, so (with -ffp-contract=off) a vertex gets the same clip
+/// position, bit for bit, whichever computes it.
+inline glm::dvec4 clip_position(const glm::dmat4& mvp, const glm::vec3& position) {
+  return mvp * glm::dvec4(glm::dvec3(position), 1.0);
+}
+
 }  // namespace
 
 // Hidden back-face culling. The back faces of an instance are dropped when all of these hold:
@@ -83,7 +90,6 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
     vertices_[i].block_outcodes.resize(
         (scene.meshes[i].mesh->positions.size() + kVerticesPerTransformBlock - 1) /
         kVerticesPerTransformBlock);
-    vertices_[i].clip.resize(scene.meshes[i].mesh->positions.size());
     vertices_[i].outcode.resize(scene.meshes[i].mesh->positions.size());
     vertices_[i].snapped.resize(scene.meshes[i].mesh->positions.size());
     if (scene.meshes[i].color_source == ColorSource::Vertex) {
@@ -159,9 +165,8 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
     const std::size_t block_end = std::min(end, (block + 1) * kVerticesPerTransformBlock);
     unsigned codes = 0;
     for (std::size_t v = block_begin; v < block_end; ++v) {
-      const glm::dvec4 clip = mvp * glm::dvec4(glm::dvec3(inst.mesh->positions[v]), 1.0);
+      const glm::dvec4 clip = clip_position(mvp, inst.mesh->positions[v]);
       const auto code = std::uint8_t(outcode(clip));
-      out.clip[v] = clip;
       out.outcode[v] = code;
       codes |= code;
       if (code == 0) out.snapped[v] = snap(clip);
@@ -205,6 +210,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     if (g >= run_end) continue;  // an instance without triangles
     const MeshInstance& inst = scene_.meshes[instance];
     const InstanceVertices& iv = vertices_[instance];
+    const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
     const std::uint32_t* indices = inst.mesh->indices.data() + (g - first_triangle_[instance]) * 3;
     // A uniform colour is flat unless it is NaN (the per-triangle comparison's result).
@@ -242,7 +248,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
         emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]], color,
                       flat, primitive, std::uint32_t(instance), sink);
       } else {
-        clip_triangle(instance, indices, color, flat, c0 | c1 | c2, primitive, sink);
+        clip_triangle(instance, mvp, indices, color, flat, c0 | c1 | c2, primitive, sink);
       }
     }
   }
@@ -325,13 +331,13 @@ void GeometryFrontEnd::emit_triangle(const SnappedVertex& v0, const SnappedVerte
   t.flat_color = flat;
 }
 
-void GeometryFrontEnd::clip_triangle(std::size_t instance, const std::uint32_t* idx,
-                                     const glm::vec3* color, bool flat, unsigned out_any,
-                                     std::uint32_t primitive, Sink& sink) const {
-  const InstanceVertices& iv = vertices_[instance];
+void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp,
+                                     const std::uint32_t* idx, const glm::vec3* color, bool flat,
+                                     unsigned out_any, std::uint32_t primitive, Sink& sink) const {
+  const std::vector<glm::vec3>& positions = scene_.meshes[instance].mesh->positions;
   ++sink.counters.clipped;
   ClipPolygon poly, next;
-  for (int k = 0; k < 3; ++k) poly[k] = ClipVertex{iv.clip[idx[k]], color[k]};
+  for (int k = 0; k < 3; ++k) poly[k] = ClipVertex{clip_position(mvp, positions[idx[k]]), color[k]};
   int count = 3;
   // Sutherland-Hodgman. The intersection on an edge is always computed from its inside
   // vertex towards its outside vertex, so that two triangles sharing the edge get the

@@ -39,10 +39,13 @@ struct SnappedVertex {
   float inv_w;      ///< 1 / clip w
 };
 
-/// Clip-space vertices of one mesh instance, with their clip outcodes and, for vertices
-/// inside every plane, their snapped screen position (shared by all their triangles).
+/// Per-vertex transform results of one mesh instance: clip outcodes and, for vertices inside
+/// every plane, their snapped screen position (shared by all their triangles). Sized, and so
+/// first touched, by the constructor; every frame's transform_vertices rewrites them in place,
+/// so repeated frames take no page faults here. Clip-space positions are not stored (8 MB per
+/// 250k vertices, written every frame): the few triangles that need clipping recompute theirs
+/// with clip_position, bit for bit the values the outcodes came from.
 struct InstanceVertices {
-  std::vector<glm::dvec4> clip;
   std::vector<std::uint8_t> outcode;    ///< bit p set: outside clip plane p
   std::vector<SnappedVertex> snapped;   ///< valid where outcode == 0
   std::vector<glm::vec3> color_linear;  ///< only for ColorSource::Vertex
@@ -127,8 +130,10 @@ class GeometryFrontEnd {
   void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
                      const glm::vec3* color, bool flat, std::uint32_t primitive,
                      std::uint32_t surface, Sink& sink) const;
-  void clip_triangle(std::size_t instance, const std::uint32_t* idx, const glm::vec3* color,
-                     bool flat, unsigned out_any, std::uint32_t primitive, Sink& sink) const;
+  /// `mvp`: view_projection_ times the instance's model matrix, as in transform_vertices.
+  void clip_triangle(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
+                     const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,
+                     Sink& sink) const;
   void setup_range(std::uint32_t chunk, Sink& sink) const;
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
