@@ -415,7 +415,8 @@ inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const Tria
     sums.depth = std::numeric_limits<float>::infinity();
   } else if (layer_[pixel] == Layer::Mixed) {
     return;
-  } else if (sums.key != key || !share_vertex(*t, *pool_[tail_[pixel]].triangle)) {
+  } else if (sums.key != key || !(share_vertex(*t, *pool_[tail_[pixel]].triangle) ||
+                                  share_vertex(*t, *pool_[head_[pixel]].triangle))) {
     layer_[pixel] = Layer::Mixed;
     return;
   }

@@ -149,8 +149,9 @@ class ABufferTile {
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
   /// Per pixel, whether its fragments so far are one layer: all of one mesh instance and
-  /// facing, each sharing a vertex with the one before it (so the layer is connected and its
-  /// pieces do not overlap). Such a pixel with no opaque surface resolves from the sums alone,
+  /// facing, each sharing a vertex with the one before it or with the first (so the layer is
+  /// connected and its pieces do not overlap; the first helps where a tessellation's next row
+  /// of triangles starts). Such a pixel with no opaque surface resolves from the sums alone,
   /// to exactly what the list would give (the front-layer formula of resolve_pixel).
   enum class Layer : std::uint8_t { Empty, One, Mixed };
   struct LayerSums {
