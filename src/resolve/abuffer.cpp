@@ -209,24 +209,32 @@ bool ABufferTile::add_covering_blocks(const TriangleSetup& t, const PixelRect& r
   const TriangleEdges edges(t);
   const int bx0 = (r.x0 - rect_.x0) / kBlockPx, bx1 = (r.x1 - 1 - rect_.x0) / kBlockPx;
   const int by0 = (r.y0 - rect_.y0) / kBlockPx, by1 = (r.y1 - 1 - rect_.y0) / kBlockPx;
+  // Which block corners lie inside or on every edge (E without the bias), once per corner:
+  // a block is covered completely when its four are (the triangle is convex).
+  constexpr int kMaxCorners = kMaxTilePx / kBlockPx + 1;
+  bool corner_inside[kMaxCorners][kMaxCorners];
+  for (int j = by0; j <= by1 + 1; ++j) {
+    const std::int64_t y = std::min(rect_.y0 + j * kBlockPx, rect_.y1);
+    for (int i = bx0; i <= bx1 + 1; ++i) {
+      const std::int64_t x = std::min(rect_.x0 + i * kBlockPx, rect_.x1);
+      bool inside = true;
+      for (const EdgeFunction& e : edges.e) {
+        inside &= e.at(x * kSubpixelOne, y * kSubpixelOne) - e.bias >= 0;
+      }
+      corner_inside[j - by0][i - bx0] = inside;
+    }
+  }
   bool any = false;
   for (int by = by0; by <= by1; ++by) {
     for (int bx = bx0; bx <= bx1; ++bx) {
       const std::size_t b = std::size_t(by) * block_stride_ + bx;
-      if (!block_uniform_[b]) continue;
-      const PixelRect br = block_rect(b);
-      // Covered completely: all four corners inside or on every edge (E without the bias).
-      bool inside = true;
-      for (const EdgeFunction& e : edges.e) {
-        for (const std::int64_t y : {std::int64_t(br.y0), std::int64_t(br.y1)}) {
-          for (const std::int64_t x : {std::int64_t(br.x0), std::int64_t(br.x1)}) {
-            inside &= e.at(x * kSubpixelOne, y * kSubpixelOne) - e.bias >= 0;
-          }
-        }
+      const int j = by - by0, i = bx - bx0;
+      if (!block_uniform_[b] || !corner_inside[j][i] || !corner_inside[j][i + 1] ||
+          !corner_inside[j + 1][i] || !corner_inside[j + 1][i + 1]) {
+        continue;
       }
-      if (!inside) continue;
       const TriangleSetup* opaque = block_opaque_[b];
-      const int order = opaque == nullptr ? 1 : compare_planes(t, *opaque, br);
+      const int order = opaque == nullptr ? 1 : compare_planes(t, *opaque, block_rect(b));
       if (order == 0) continue;
       if (order > 0) block_opaque_[b] = &t;
       decided_[b] = decided_stamp_;
