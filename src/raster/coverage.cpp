@@ -59,7 +59,11 @@ class CoverageRasterizer final : public TileRasterizer {
     if (r.empty()) return;
     bool skip_decided = false;
     if (!blend_ && fast_paths_) {
-      if (covers_tile(t) && abuffer_.add_covering_tile(&t)) return;
+      // Only a triangle whose box holds the tile can cover it.
+      if (r.x0 == rect_.x0 && r.y0 == rect_.y0 && r.x1 == rect_.x1 && r.y1 == rect_.y1 &&
+          covers_tile(t) && abuffer_.add_covering_tile(&t)) {
+        return;
+      }
       // Only a triangle at least a block wide and high can cover a whole block.
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
     }
@@ -75,15 +79,21 @@ class CoverageRasterizer final : public TileRasterizer {
       const int first = rows.first, end = rows.end;
       const int interior_begin = rows.interior_begin, interior_end = rows.interior_end;
       std::uint16_t* out = plane_.data() + std::size_t(first - rect_.y0) * plane_stride_;
-      // Top partial run, interior run, bottom partial run.
-      kernel_(cols, 0, first, interior_begin, tri.sign, out, plane_stride_);
-      for (int y = interior_begin; y < interior_end; ++y) {
-        std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
-        for (int lane = 0; lane < kColumnGroup; ++lane)
-          row[lane] = std::uint16_t(cols.width_q[0][lane]);
+      if (interior_begin == interior_end) {
+        // No interior run (small triangles): one kernel call for all rows.
+        kernel_(cols, 0, first, end, tri.sign, out, plane_stride_);
+      } else {
+        // Top partial run, interior run, bottom partial run.
+        kernel_(cols, 0, first, interior_begin, tri.sign, out, plane_stride_);
+        for (int y = interior_begin; y < interior_end; ++y) {
+          std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
+          for (int lane = 0; lane < kColumnGroup; ++lane)
+            row[lane] = std::uint16_t(cols.width_q[0][lane]);
+        }
+        kernel_(cols, 0, interior_end, end, tri.sign,
+                plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_,
+                plane_stride_);
       }
-      kernel_(cols, 0, interior_end, end, tri.sign,
-              plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_, plane_stride_);
       consume(t, g, lanes, first, end, skip_decided);
     }
   }
