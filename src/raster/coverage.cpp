@@ -142,6 +142,12 @@ class CoverageRasterizer final : public TileRasterizer {
 
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
   void consume(const TriangleSetup& t, int g, int lanes, int first, int end, bool skip_decided) {
+    // The depth plane at the pixel centres, split as TriangleSetup::depth_at evaluates it,
+    // (z0 + dzdx (x - vx)) + dzdy (y - vy), so that the sum is the same bits.
+    const double vx = t.x_fx8[0] * (1.0 / kSubpixelOne), vy = t.y_fx8[0] * (1.0 / kSubpixelOne);
+    double column_z[kColumnGroup];
+    for (int lane = 0; lane < lanes; ++lane)
+      column_z[lane] = t.z0 + t.dzdx * ((g + lane + 0.5) - vx);
     for (int y = first; y < end; ++y) {
       // Aligned groups: the row lies in one block, decided as a whole.
       if (skip_decided && abuffer_.block_decided(g, y)) continue;
@@ -153,12 +159,13 @@ class CoverageRasterizer final : public TileRasterizer {
       if (!blend_) {
         abuffer_.prepare_row(g + std::countr_zero(covered), g + std::bit_width(covered), y);
       }
+      const double row_z = t.dzdy * ((y + 0.5) - vy);
       for (; covered != 0; covered &= covered - 1) {
         const int lane = std::countr_zero(covered);
         const std::uint32_t coverage = row[lane];
         const int x = g + lane;
         if (!blend_) {
-          abuffer_.add(x, y, &t, coverage);
+          abuffer_.add(x, y, &t, coverage, column_z[lane] + row_z);
           continue;
         }
         // The seed's compositing: one depth per pixel, blend with the 8-bit alpha.

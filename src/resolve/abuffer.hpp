@@ -60,8 +60,8 @@ class ABufferTile {
   /// leaves the whole-tile state and writes out the state of uniform blocks.
   inline void prepare_row(int x0, int x1, int y);
   /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile, which
-  /// prepare_row() has made ready.
-  inline void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage);
+  /// prepare_row() has made ready; `centre_z` is t->depth_at(x + 0.5, y + 0.5), bit for bit.
+  inline void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage, double centre_z);
   /// Whole-tile fast path for a triangle that covers every pixel of the tile: while every
   /// pixel still shows one opaque triangle (or the background) and nothing else, the new
   /// plane is compared with that one once, at the tile's corners (their difference is
@@ -196,9 +196,9 @@ inline void ABufferTile::prepare_row(int x0, int x1, int y) {
   if (const std::size_t b = block_of(x1 - 1, y); block_uniform_[b]) materialize_block(b);
 }
 
-inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage) {
+inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
+                             double centre_z) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-  const double centre_z = t->depth_at(x + 0.5, y + 0.5);
   if (opaque_[pixel] == nullptr) {
     if (coverage == std::uint32_t(kCoverageOne)) {
       opaque_[pixel] = t;
