@@ -598,35 +598,19 @@ namespace {
 using covrast::detail::CoverageEdge;
 using covrast::detail::GroupRows;
 
-/// make_coverage_triangle as first written (std::sort on (x, y), then canonical edges): the
-/// reference for its sorting network.
+/// make_coverage_triangle of the same vertices handed to it already in std::sort's (x, then
+/// y) order: the sorting network must give exactly this for every permutation of them.
 CoverageTriangle reference_coverage_triangle(const TriangleSetup& t) {
   int order[3] = {0, 1, 2};
   std::sort(order, order + 3, [&](int i, int j) {
     return t.x_fx8[i] < t.x_fx8[j] || (t.x_fx8[i] == t.x_fx8[j] && t.y_fx8[i] < t.y_fx8[j]);
   });
-  auto edge = [](double xa, double ya, double xb, double yb) {
-    if (xb < xa || (xb == xa && yb < ya)) {
-      std::swap(xa, xb);
-      std::swap(ya, yb);
-    }
-    CoverageEdge e{xa, ya, xb, yb, 0.0};
-    if (xb > xa) e.slope = (yb - ya) / (xb - xa);
-    return e;
-  };
-  const std::int64_t xa = t.x_fx8[order[0]], ya = t.y_fx8[order[0]];
-  const std::int64_t xb = t.x_fx8[order[1]], yb = t.y_fx8[order[1]];
-  const std::int64_t xc = t.x_fx8[order[2]], yc = t.y_fx8[order[2]];
-  const double s = 1.0 / kSubpixelOne;
-  CoverageTriangle tri;
-  tri.edge[0] = edge(xa * s, ya * s, xc * s, yc * s);
-  tri.edge[1] = edge(xa * s, ya * s, xb * s, yb * s);
-  tri.edge[2] = edge(xb * s, yb * s, xc * s, yc * s);
-  const std::int64_t cross = (xc - xa) * (yb - ya) - (yc - ya) * (xb - xa);
-  tri.sign = cross > 0 ? -1 : +1;
-  tri.x_min = xa * s;
-  tri.x_max = xc * s;
-  return tri;
+  TriangleSetup sorted = t;
+  for (int k = 0; k < 3; ++k) {
+    sorted.x_fx8[k] = t.x_fx8[order[k]];
+    sorted.y_fx8[k] = t.y_fx8[order[k]];
+  }
+  return covrast::detail::make_coverage_triangle(sorted);
 }
 
 bool same_bits(double a, double b) {
