@@ -3,13 +3,17 @@
 //
 // Fully covered pixels take a fast path: an ordinary depth test against one opaque
 // surface per pixel (depth planes compared at the pixel's four corners, so a plane that
-// crosses the opaque one inside the pixel is kept as a fragment instead). Partly covered
-// pixels keep a short list of fragments (triangle, 8.8 coverage), resolved front to back
-// when the tile is done:
+// crosses the opaque one inside the pixel is kept as a fragment instead). The same test
+// runs once per tile, and once per 8x8 block, while the tile or block still shows a single
+// opaque triangle and the new one covers it completely; per-pixel state is written only
+// when a block needs it. Partly covered pixels keep a short list of fragments (triangle,
+// 8.8 coverage), resolved front to back when the tile is done:
 //  - one layer (fragments of one mesh instance and facing, connected through shared
 //    vertices) in front of everything else, alone or filling the pixel:
-//    colour = sum(coverage_i * colour_i) + (1 - sum coverage) * behind; adjacent triangles of
-//    a tessellation add to exactly one pixel, so no background leaks through seams;
+//    colour = sum(coverage_i * colour_i) / max(sum coverage, 1) + (1 - sum coverage) *
+//    behind; adjacent triangles of a tessellation add to exactly one pixel, so no background
+//    leaks through seams. A pixel whose fragments form one layer as they arrive keeps these
+//    sums as it goes and resolves from them, without walking its list;
 //  - otherwise, per 8x8 sub-pixel samples from the same fixed-point edge functions, with
 //    per-sample depth from each triangle's plane: a fragment's weight is its coverage times
 //    the share of its samples where it is the nearest; what remains goes to the opaque
