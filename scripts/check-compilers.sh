@@ -1,15 +1,19 @@
 #!/usr/bin/env bash
-# Checks the determinism promise across compilers: builds the command line with clang into
-# build/clang-check and renders scenes in every mode with it and with the g++ build given
-# (default build/release/covrast); every PNG must be byte-identical.
+# Checks the second compiler of the design card and the determinism promise across
+# compilers: builds everything (library, command line, tests, benchmarks) with clang and
+# -Werror into build/clang-check, runs the test suite built by clang, and renders scenes in
+# every mode with the clang and the given g++ build (default build/release/covrast); every
+# PNG must be byte-identical.
 # Usage: scripts/check-compilers.sh [GXX_COVRAST]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 gxx_bin=${1:-build/release/covrast}
 clang_dir=build/clang-check
 cmake -S . -B "$clang_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
-  -DCOVRAST_BUILD_TESTS=OFF -DCOVRAST_BUILD_BENCHMARKS=OFF >/dev/null
-cmake --build "$clang_dir" --target covrast_cli -j 2 >/dev/null
+  -DCOVRAST_WERROR=ON >/dev/null
+cmake --build "$clang_dir" -j 2 >/dev/null
+"$clang_dir/tests/covrast_tests" --order decl >/dev/null
+echo "clang build: warnings as errors, test suite passed"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
 pairs=0

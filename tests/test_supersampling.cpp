@@ -48,8 +48,6 @@ using covrast::detail::TriangleSetup;
 using covrast::test::add_instance;
 using covrast::test::uv_sphere;
 
-constexpr double kPi = 3.14159265358979323846;
-
 // ---------------------------------------------------------------------------------------
 // Screen triangles
 
