@@ -79,6 +79,11 @@ std::string to_string(const RenderMode& mode) {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// How many binned triangles ahead the tile loop prefetches (each draw takes long enough for
+/// a fetch from memory to arrive in time).
+constexpr std::size_t kPrefetchAhead = 4;
+
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
@@ -199,8 +204,18 @@ RenderResult Renderer::render_frame() {
                           raster.begin_tile(im.grid.tile_rect(tile), target);
                           for (std::size_t c = 0; c < im.chunk_bins.size(); ++c) {
                             const auto& tris = im.chunk_triangles[c];
-                            for (std::uint32_t i : im.chunk_bins[c].tile(tile))
-                              raster.draw(tris[i]);
+                            const std::span<const std::uint32_t> list = im.chunk_bins[c].tile(tile);
+                            for (std::size_t k = 0; k < list.size(); ++k) {
+                              // The tile's triangles are scattered through the chunk: fetch
+                              // the set-up (two cache lines) a few triangles ahead.
+                              if (k + kPrefetchAhead < list.size()) {
+                                const char* ahead =
+                                    reinterpret_cast<const char*>(&tris[list[k + kPrefetchAhead]]);
+                                __builtin_prefetch(ahead);
+                                __builtin_prefetch(ahead + 64);
+                              }
+                              raster.draw(tris[list[k]]);
+                            }
                           }
                           Clock::time_point r0 = Clock::now();
                           raster.end_tile(target);
