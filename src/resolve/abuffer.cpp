@@ -73,6 +73,71 @@ bool layer_neighbours(const TriangleSetup& a, bool a_merged, DepthRange ra, cons
   return (a_merged || b_merged) && !(ra.max < rb.min || rb.max < ra.min);
 }
 
+/// A convex polygon in pixel coordinates: the pixel square clipped by up to four lines.
+struct ClipPolygon {
+  double x[8], y[8];
+  int n = 0;
+};
+
+/// Keeps the part of `poly` where the affine function f(x, y) = c + a x + b y is >= 0.
+void clip_half_plane(ClipPolygon& poly, double c, double a, double b) {
+  ClipPolygon out;
+  for (int i = 0; i < poly.n; ++i) {
+    const int j = (i + 1) % poly.n;
+    const double fi = c + a * poly.x[i] + b * poly.y[i];
+    const double fj = c + a * poly.x[j] + b * poly.y[j];
+    if (fi >= 0) {
+      out.x[out.n] = poly.x[i];
+      out.y[out.n++] = poly.y[i];
+    }
+    if ((fi >= 0) != (fj >= 0)) {
+      const double u = fi / (fi - fj);
+      out.x[out.n] = poly.x[i] + u * (poly.x[j] - poly.x[i]);
+      out.y[out.n++] = poly.y[i] + u * (poly.y[j] - poly.y[i]);
+    }
+  }
+  poly = out;
+}
+
+double polygon_area(const ClipPolygon& poly) {
+  double twice = 0;
+  for (int i = 0; i < poly.n; ++i) {
+    const int j = (i + 1) % poly.n;
+    twice += poly.x[i] * poly.y[j] - poly.x[j] * poly.y[i];
+  }
+  return 0.5 * std::fabs(twice);
+}
+
+/// The share of triangle `t`'s part of pixel (x, y) where its plane is nearer than the
+/// opaque plane `o`: the pixel square clipped by t's three edges, then by the line where the
+/// planes meet (both affine, so the line is straight), by exact polygon clipping in double.
+/// Negative when t's part is too thin to measure.
+double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int y) {
+  ClipPolygon poly;
+  const double px[4] = {double(x), double(x + 1), double(x + 1), double(x)};
+  const double py[4] = {double(y), double(y), double(y + 1), double(y + 1)};
+  for (int k = 0; k < 4; ++k) {
+    poly.x[k] = px[k];
+    poly.y[k] = py[k];
+  }
+  poly.n = 4;
+  // Inside edge i -> j (positive doubled area, y down): (xj - xi)(py - yi) - (yj - yi)(px - xi) >=
+  // 0.
+  const double s = 1.0 / kSubpixelOne;
+  for (int i = 0; i < 3 && poly.n > 0; ++i) {
+    const int j = (i + 1) % 3;
+    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
+    const double dx = t.x_fx8[j] * s - xi, dy = t.y_fx8[j] * s - yi;
+    clip_half_plane(poly, dy * xi - dx * yi, -dy, dx);
+  }
+  const double inside = polygon_area(poly);
+  if (!(inside > 1e-12)) return -1.0;
+  // Nearer where d = z_o - z_t > 0; d is affine: d(p) = d0 + ddx x + ddy y.
+  const double d0 = o.depth_at(0.0, 0.0) - t.depth_at(0.0, 0.0);
+  clip_half_plane(poly, d0, o.dzdx - t.dzdx, o.dzdy - t.dzdy);
+  return std::clamp(polygon_area(poly) / inside, 0.0, 1.0);
+}
+
 }  // namespace
 
 /// How plane `t` lies against plane `other` over pixel (x, y). Both are affine, so their
@@ -544,7 +609,15 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     return front_layer_color(sums, behind);
   }
   double weight[kMaxFragmentsPerPixel];
-  sample_weights(x, y, opaque, n, tri, cov, merged, weight);
+  // One triangle crossing the opaque plane inside the pixel (where two surfaces
+  // interpenetrate): its visible part is exact by polygon clipping, no masks needed.
+  const double share =
+      n == 1 && crossing && merged[0] == nullptr ? visible_share(*tri[0], *opaque, x, y) : -1.0;
+  if (share >= 0.0) {
+    weight[0] = double(cov[0]) / kCoverageOne * share;
+  } else {
+    sample_weights(x, y, opaque, n, tri, cov, merged, weight);
+  }
   double total = 0;
   for (int i = 0; i < n; ++i) total += weight[i];
   const double scale = total > 1.0 ? 1.0 / total : 1.0;
