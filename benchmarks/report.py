@@ -512,7 +512,10 @@ def headline(results):
             text += (f", and its A-buffer merged fragments {cov['overflows']:,} times on list "
                      f"overflow at {r['error_size'][0]}x{r['error_size'][1]}")
         sentences.append(text + ".")
-    if total:
+    if total and matched == 0:
+        sentences.append(
+            f"Over the {total} scenes, no ssaa mode up to 16x16 matches coverage's RMSE.")
+    elif total:
         sentences.append(
             f"Over the {total} scenes, ssaa up to 16x16 matches coverage's RMSE in {matched}, and "
             f"where it does it is slower than coverage in {faster} of {matched}.")
