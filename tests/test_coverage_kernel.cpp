@@ -14,6 +14,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_targets.hpp"
+
 #include <algorithm>
 #include <array>
 #include <bit>
@@ -628,17 +630,6 @@ bool same_triangle(const CoverageTriangle& a, const CoverageTriangle& b) {
   return a.sign == b.sign && same_bits(a.x_min, b.x_min) && same_bits(a.x_max, b.x_max);
 }
 
-/// Highway targets compiled into the kernels and supported by this CPU, best first. Call
-/// before forcing any target: SupportedTargets() reports the mock once one is set.
-std::vector<std::int64_t> usable_targets() {
-  std::vector<std::int64_t> targets;
-  for (std::int64_t bits = covrast::detail::coverage_kernel_targets() & hwy::SupportedTargets();
-       bits != 0; bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
-  return targets;
-}
-
 /// Writes a quiet-NaN pattern (never a set-up value) to the group's lanes of all arrays, so
 /// a lane the set-up leaves unwritten differs from the reference.
 void poison_group(CoverageColumns& c, std::uint32_t pattern) {
@@ -740,7 +731,8 @@ TEST_CASE("coverage set-up: the sorting network orders vertices as std::sort", "
 }
 
 TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[coverage]") {
-  const std::vector<std::int64_t> targets = usable_targets();
+  const std::vector<std::int64_t> targets =
+      covrast::test::usable_targets(covrast::detail::coverage_kernel_targets());
   REQUIRE(!targets.empty());
   std::mt19937 rng(0x5e7091u);
   auto pick = [&](std::uint32_t n) {

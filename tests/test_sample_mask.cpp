@@ -12,6 +12,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_targets.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
@@ -92,21 +94,11 @@ std::string describe(const TriangleSetup& t, int x, int y) {
   return s.str();
 }
 
-/// Highway targets compiled into the mask and supported by this CPU, best first. Call before
-/// forcing any target: SupportedTargets() reports the mock once one is set.
-std::vector<std::int64_t> usable_targets() {
-  std::vector<std::int64_t> targets;
-  for (std::int64_t bits = covrast::detail::sample_mask_targets() & hwy::SupportedTargets();
-       bits != 0; bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
-  return targets;
-}
-
 /// Runs `check(name, fn)` with the scalar reference and with pixel_sample_mask forced to
 /// each usable target in turn; restores the best target afterwards.
 void for_each_implementation(const std::function<void(const std::string&, MaskFn)>& check) {
-  const std::vector<std::int64_t> targets = usable_targets();
+  const std::vector<std::int64_t> targets =
+      covrast::test::usable_targets(covrast::detail::sample_mask_targets());
   REQUIRE(!targets.empty());
   check("scalar", pixel_sample_mask_scalar);
   for (std::int64_t target : targets) {
@@ -375,7 +367,8 @@ TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[covera
   CHECK(empty > 20000);
 
   std::string names;
-  for (std::int64_t t : usable_targets()) names += std::string(hwy::TargetName(t)) + " ";
+  for (std::int64_t t : covrast::test::usable_targets(covrast::detail::sample_mask_targets()))
+    names += std::string(hwy::TargetName(t)) + " ";
   WARN("sample mask targets compiled and supported here: " << names);
   for_each_implementation([&](const std::string& name, MaskFn mask) {
     INFO(name);
