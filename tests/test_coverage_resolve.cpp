@@ -99,6 +99,20 @@ std::shared_ptr<MeshData> screen_mesh(const Scene& s, const std::vector<ScreenVe
   return m;
 }
 
+/// Adds two screen triangles of uniform colours c1 and c2, drawn in this order: as two
+/// meshes, or as one mesh with vertex colours (then they are one surface).
+void add_triangle_pair(Scene& s, const std::vector<ScreenVertex>& first, glm::vec3 c1,
+                       const std::vector<ScreenVertex>& second, glm::vec3 c2, bool one_mesh) {
+  if (!one_mesh) {
+    add_instance(s, screen_mesh(s, first), c1);
+    add_instance(s, screen_mesh(s, second), c2);
+    return;
+  }
+  std::vector<ScreenVertex> v = first;
+  v.insert(v.end(), second.begin(), second.end());
+  add_instance(s, screen_mesh(s, v, {c1, c1, c1, c2, c2, c2}), glm::vec3(1), ColorSource::Vertex);
+}
+
 /// n x n cells over [x0, x1] x [y0, y1] (pixels) at world depth z, interior vertices jittered by up
 /// to 0.2 cell (below 0.25: every cell stays convex, no triangle folds over).
 std::shared_ptr<MeshData> tessellated_square(const Scene& s, double x0, double y0, double x1,
@@ -705,15 +719,7 @@ TEST_CASE("coverage mode: a partial occluder hides only where it covers", "[cove
     const auto& first = front_first ? front : back;
     const auto& second = front_first ? back : front;
     const glm::vec3 c1 = front_first ? red : blue, c2 = front_first ? blue : red;
-    if (one_mesh) {
-      std::vector<ScreenVertex> v = first;
-      v.insert(v.end(), second.begin(), second.end());
-      add_instance(s, screen_mesh(s, v, {c1, c1, c1, c2, c2, c2}), glm::vec3(1),
-                   ColorSource::Vertex);
-    } else {
-      add_instance(s, screen_mesh(s, first), c1);
-      add_instance(s, screen_mesh(s, second), c2);
-    }
+    add_triangle_pair(s, first, c1, second, c2, one_mesh);
     const std::vector<TriangleSetup> tris = screen_triangles(s);
     REQUIRE(tris.size() == 2);
     REQUIRE(tris[0].front_facing == tris[1].front_facing);
@@ -741,11 +747,8 @@ TEST_CASE("coverage mode: a steep fold of one mesh hides the part behind it", "[
   const std::vector<ScreenVertex> f = {{30.5, 5.0, 0.0}, {20.0, 20.0, 8.0}, {30.5, 35.0, 0.0}};
   const std::vector<ScreenVertex> b = {
       {10.0, 20.5, -1.37}, {50.0, 20.5, -1.37}, {30.0, 2.0, -1.37}};
-  std::vector<ScreenVertex> v = f;
-  v.insert(v.end(), b.begin(), b.end());
   const glm::vec3 red(1, 0, 0), blue(0, 0, 1);
-  add_instance(s, screen_mesh(s, v, {red, red, red, blue, blue, blue}), glm::vec3(1),
-               ColorSource::Vertex);
+  add_triangle_pair(s, f, red, b, blue, true);
   const std::vector<TriangleSetup> tris = screen_triangles(s);
   REQUIRE(tris.size() == 2);
   REQUIRE(tris[0].front_facing == tris[1].front_facing);
@@ -828,15 +831,7 @@ TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sampl
   const glm::vec3 red(1, 0, 0), sky(0, 0.5f, 1);
   for (bool one_mesh : {false, true}) {
     Scene s = make_scene(64, 48, glm::vec3(0));
-    if (one_mesh) {
-      std::vector<ScreenVertex> v = a;
-      v.insert(v.end(), b.begin(), b.end());
-      add_instance(s, screen_mesh(s, v, {red, red, red, sky, sky, sky}), glm::vec3(1),
-                   ColorSource::Vertex);
-    } else {
-      add_instance(s, screen_mesh(s, a), red);
-      add_instance(s, screen_mesh(s, b), sky);
-    }
+    add_triangle_pair(s, a, red, b, sky, one_mesh);
     const std::vector<TriangleSetup> tris = screen_triangles(s);
     REQUIRE(tris.size() == 2);
     const Comparison c = compare(render(s, ModeKind::Coverage).color, reference_render(s, tris));

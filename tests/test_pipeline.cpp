@@ -695,29 +695,11 @@ TEST_CASE("a tessellated floor crossing the near plane stays watertight", "[pipe
     Image image = render_with(uniform, "coverage").color;
     // A pixel square lies wholly inside (outside) when its centre is inside (outside) and
     // more than half a diagonal, 0.7072 px, from the boundary.
-    std::size_t inside = 0, outside = 0, wrong = 0;
-    std::string first;
-    for (int y = 0; y < image.height; ++y) {
-      for (int x = 0; x < image.width; ++x) {
-        glm::dvec2 c(x + 0.5, y + 0.5);
-        double distance = 1e300;
-        for (std::size_t k = 0; k < poly.size(); ++k) {
-          distance = std::min(distance, segment_distance(c, poly[k], poly[(k + 1) % poly.size()]));
-        }
-        if (distance < 0.7072) continue;
-        bool in = inside_convex(poly, c);
-        (in ? inside : outside)++;
-        Rgb expected = in ? Rgb{255, 255, 255} : Rgb{0, 0, 0};
-        if (pixel_at(image, x, y) != expected && wrong++ == 0) {
-          first = "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ") is " +
-                  describe(pixel_at(image, x, y)) + ", expected " + describe(expected);
-        }
-      }
-    }
-    INFO(first);
-    CHECK(wrong == 0);
-    CHECK(inside > 3000);
-    CHECK(outside > 3000);
+    const PolygonCheck r = check_polygon(image, poly, Rgb{255, 255, 255}, Rgb{0, 0, 0}, 0.7072);
+    INFO(r.first_wrong);
+    CHECK(r.wrong == 0);
+    CHECK(r.inside > 3000);
+    CHECK(r.outside > 3000);
   }
 }
 
