@@ -6,7 +6,6 @@
 //  - coverage-blend: the literal seed, alpha-blended over the frame buffer with one depth
 //                    per pixel (kept to show what the A-buffer fixes).
 #include "raster/coverage_kernel.hpp"
-#include "raster/edge_function.hpp"
 #include "raster/shading.hpp"
 #include "raster/tile_raster.hpp"
 #include "resolve/abuffer.hpp"
@@ -59,11 +58,7 @@ class CoverageRasterizer final : public TileRasterizer {
     if (r.empty()) return;
     bool skip_decided = false;
     if (!blend_ && fast_paths_) {
-      // Only a triangle whose box holds the tile can cover it.
-      if (r.x0 == rect_.x0 && r.y0 == rect_.y0 && r.x1 == rect_.x1 && r.y1 == rect_.y1 &&
-          covers_tile(t) && abuffer_.add_covering_tile(&t)) {
-        return;
-      }
+      if (abuffer_.add_covering_tile(t, r)) return;
       // Only a triangle at least a block wide and high can cover a whole block.
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
     }
@@ -122,24 +117,6 @@ class CoverageRasterizer final : public TileRasterizer {
   bool fast_paths_ = !g_pixel_path_only.load(std::memory_order_relaxed);
 
  private:
-  /// Whether the triangle covers every pixel of the tile completely: all four corners of
-  /// the tile rectangle are inside or on each edge (the triangle is convex), exact in int64.
-  bool covers_tile(const TriangleSetup& t) const {
-    const TriangleEdges edges(t);
-    const std::int64_t xs[2] = {std::int64_t(rect_.x0) * kSubpixelOne,
-                                std::int64_t(rect_.x1) * kSubpixelOne};
-    const std::int64_t ys[2] = {std::int64_t(rect_.y0) * kSubpixelOne,
-                                std::int64_t(rect_.y1) * kSubpixelOne};
-    for (const EdgeFunction& e : edges.e) {
-      for (std::int64_t y : ys) {
-        for (std::int64_t x : xs) {
-          if (e.at(x, y) - e.bias < 0) return false;  // E without the top-left bias
-        }
-      }
-    }
-    return true;
-  }
-
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
   void consume(const TriangleSetup& t, int g, int lanes, int first, int end, bool skip_decided) {
     // The depth plane at the pixel centres, split as TriangleSetup::depth_at evaluates it,

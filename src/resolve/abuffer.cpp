@@ -55,11 +55,36 @@ bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
   return false;
 }
 
-/// A triangle's depth over pixel (x, y), from its centre: z(centre) -+ (|dz/dx| + |dz/dy|) / 2.
-DepthRange pixel_depth_range(const TriangleSetup& t, int x, int y) {
-  const double centre_z = t.depth_at(x + 0.5, y + 0.5);
+/// Pixel (x, y) showing `opaque` (null: the background) alone: its colour, and its window
+/// depth in `depth`.
+glm::vec3 opaque_pixel(const TriangleSetup* opaque, int x, int y, glm::vec3 background,
+                       float& depth) {
+  const double cx = x + 0.5, cy = y + 0.5;
+  depth =
+      opaque != nullptr ? float(opaque->depth_at(cx, cy)) : std::numeric_limits<float>::infinity();
+  return opaque != nullptr ? shade(*opaque, cx, cy, true) : background;
+}
+
+/// Whether pixel corner (x_px, y_px) lies inside or on every edge of the triangle (E without
+/// the top-left bias), exact in int64: a rectangle whose four corners do is covered
+/// completely (the triangle is convex).
+bool corner_inside(const TriangleEdges& edges, std::int64_t x_px, std::int64_t y_px) {
+  bool inside = true;
+  for (const EdgeFunction& e : edges.e) {
+    inside &= e.at(x_px * kSubpixelOne, y_px * kSubpixelOne) - e.bias >= 0;
+  }
+  return inside;
+}
+
+/// A triangle's depth over a pixel from its depth at the pixel centre: z(centre) -+
+/// (|dz/dx| + |dz/dy|) / 2.
+DepthRange range_around(const TriangleSetup& t, double centre_z) {
   const double reach = 0.5 * (std::fabs(t.dzdx) + std::fabs(t.dzdy));
   return DepthRange{centre_z - reach, centre_z + reach};
+}
+
+DepthRange pixel_depth_range(const TriangleSetup& t, int x, int y) {
+  return range_around(t, t.depth_at(x + 0.5, y + 0.5));
 }
 
 /// Whether two fragments are pieces of one layer of a surface: same mesh instance and facing,
@@ -71,6 +96,44 @@ bool layer_neighbours(const TriangleSetup& a, bool a_merged, DepthRange ra, cons
   if (!same_surface(a, b)) return false;
   if (share_vertex(a, b)) return true;
   return (a_merged || b_merged) && !(ra.max < rb.min || rb.max < ra.min);
+}
+
+/// The front layer of a pixel's fragments: the one nearest at its nearest point (among the
+/// `active` ones; null: all) and every fragment connected to it through `connected`,
+/// transitively. Marks them in `in_layer` and returns their count, summed coverage and the
+/// farthest depth they reach (members 0 when no fragment is active).
+struct FrontLayer {
+  int members;
+  std::uint32_t coverage;
+  double max_depth;
+};
+template <class Connected>
+FrontLayer find_front_layer(int n, const DepthRange* range, const std::uint32_t* coverage,
+                            const bool* active, Connected connected, bool* in_layer) {
+  int nearest = -1;
+  for (int i = 0; i < n; ++i) {
+    in_layer[i] = false;
+    if ((active == nullptr || active[i]) && (nearest < 0 || range[i].min < range[nearest].min)) {
+      nearest = i;
+    }
+  }
+  if (nearest < 0) return FrontLayer{0, 0, 0.0};
+  int stack[kMaxFragmentsPerPixel], top = 0;
+  in_layer[nearest] = true;
+  stack[top++] = nearest;
+  FrontLayer layer{1, coverage[nearest], range[nearest].max};
+  while (top > 0) {
+    const int m = stack[--top];
+    for (int j = 0; j < n; ++j) {
+      if (in_layer[j] || (active != nullptr && !active[j]) || !connected(m, j)) continue;
+      in_layer[j] = true;
+      stack[top++] = j;
+      ++layer.members;
+      layer.coverage += coverage[j];
+      layer.max_depth = std::max(layer.max_depth, range[j].max);
+    }
+  }
+  return layer;
 }
 
 /// A convex polygon in pixel coordinates: the pixel square clipped by up to four lines.
@@ -274,19 +337,14 @@ bool ABufferTile::add_covering_blocks(const TriangleSetup& t, const PixelRect& r
   const TriangleEdges edges(t);
   const int bx0 = (r.x0 - rect_.x0) / kBlockPx, bx1 = (r.x1 - 1 - rect_.x0) / kBlockPx;
   const int by0 = (r.y0 - rect_.y0) / kBlockPx, by1 = (r.y1 - 1 - rect_.y0) / kBlockPx;
-  // Which block corners lie inside or on every edge (E without the bias), once per corner:
-  // a block is covered completely when its four are (the triangle is convex).
+  // Which block corners the triangle holds, once per corner (blocks share them).
   constexpr int kMaxCorners = kMaxTilePx / kBlockPx + 1;
-  bool corner_inside[kMaxCorners][kMaxCorners];
+  bool inside[kMaxCorners][kMaxCorners];
   for (int j = by0; j <= by1 + 1; ++j) {
     const std::int64_t y = std::min(rect_.y0 + j * kBlockPx, rect_.y1);
     for (int i = bx0; i <= bx1 + 1; ++i) {
-      const std::int64_t x = std::min(rect_.x0 + i * kBlockPx, rect_.x1);
-      bool inside = true;
-      for (const EdgeFunction& e : edges.e) {
-        inside &= e.at(x * kSubpixelOne, y * kSubpixelOne) - e.bias >= 0;
-      }
-      corner_inside[j - by0][i - bx0] = inside;
+      inside[j - by0][i - bx0] =
+          corner_inside(edges, std::min(rect_.x0 + i * kBlockPx, rect_.x1), y);
     }
   }
   bool any = false;
@@ -294,8 +352,8 @@ bool ABufferTile::add_covering_blocks(const TriangleSetup& t, const PixelRect& r
     for (int bx = bx0; bx <= bx1; ++bx) {
       const std::size_t b = std::size_t(by) * block_stride_ + bx;
       const int j = by - by0, i = bx - bx0;
-      if (!block_uniform_[b] || !corner_inside[j][i] || !corner_inside[j][i + 1] ||
-          !corner_inside[j + 1][i] || !corner_inside[j + 1][i + 1]) {
+      if (!block_uniform_[b] || !inside[j][i] || !inside[j][i + 1] || !inside[j + 1][i] ||
+          !inside[j + 1][i + 1]) {
         continue;
       }
       const TriangleSetup* opaque = block_opaque_[b];
@@ -309,10 +367,17 @@ bool ABufferTile::add_covering_blocks(const TriangleSetup& t, const PixelRect& r
   return any;
 }
 
-bool ABufferTile::add_covering_tile(const TriangleSetup* t) {
+bool ABufferTile::add_covering_tile(const TriangleSetup& t, const PixelRect& r) {
   if (!tile_uniform_) return false;
-  const int order = uniform_ == nullptr ? 1 : compare_planes(*t, *uniform_, rect_);
-  if (order > 0) uniform_ = t;
+  // Only a triangle whose box holds the tile can cover it.
+  if (r.x0 != rect_.x0 || r.y0 != rect_.y0 || r.x1 != rect_.x1 || r.y1 != rect_.y1) return false;
+  const TriangleEdges edges(t);
+  if (!corner_inside(edges, rect_.x0, rect_.y0) || !corner_inside(edges, rect_.x1, rect_.y0) ||
+      !corner_inside(edges, rect_.x0, rect_.y1) || !corner_inside(edges, rect_.x1, rect_.y1)) {
+    return false;
+  }
+  const int order = uniform_ == nullptr ? 1 : compare_planes(t, *uniform_, rect_);
+  if (order > 0) uniform_ = &t;
   return order != 0;
 }
 
@@ -343,50 +408,33 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   ++overflows_;
   std::uint32_t id[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
+  std::uint32_t cov[kMaxFragmentsPerPixel];
   bool keep[kMaxFragmentsPerPixel];
   int n = 0;
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next, ++n) {
     id[n] = f;
     range[n] = pixel_depth_range(*pool_[f].triangle, x, y);
+    cov[n] = pool_[f].coverage & ~kMergedFlag;
     keep[n] = true;
   }
   auto tri = [&](int i) -> const TriangleSetup& { return *pool_[id[i]].triangle; };
   auto merged = [&](int i) { return (pool_[id[i]].coverage & kMergedFlag) != 0; };
-  auto value = [&](int i) { return pool_[id[i]].coverage & ~kMergedFlag; };
   // 1. Drop fragments that the opaque surface hides everywhere.
   if (const TriangleSetup* opaque = opaque_[pixel]; opaque != nullptr) {
     for (int i = 0; i < n; ++i) keep[i] = order_of(tri(i), *opaque, x, y) != DepthOrder::Behind;
   }
   // 2. Drop fragments wholly behind a layer that fills the pixel: the nearest fragment's
   //    connected pieces of one surface (as in resolve_pixel), when their areas add to one.
-  int nearest = -1;
-  for (int i = 0; i < n; ++i) {
-    if (keep[i] && (nearest < 0 || range[i].min < range[nearest].min)) nearest = i;
-  }
-  if (nearest >= 0) {
-    bool in_layer[kMaxFragmentsPerPixel] = {};
-    int stack[kMaxFragmentsPerPixel], top = 0;
-    in_layer[nearest] = true;
-    stack[top++] = nearest;
-    std::uint32_t layer_coverage = value(nearest);
-    double layer_max = range[nearest].max;
-    while (top > 0) {
-      const int m = stack[--top];
-      for (int j = 0; j < n; ++j) {
-        if (!keep[j] || in_layer[j] ||
-            !layer_neighbours(tri(m), merged(m), range[m], tri(j), merged(j), range[j])) {
-          continue;
-        }
-        in_layer[j] = true;
-        stack[top++] = j;
-        layer_coverage += value(j);
-        layer_max = std::max(layer_max, range[j].max);
-      }
-    }
-    if (layer_coverage >= std::uint32_t(kCoverageOne)) {
-      for (int i = 0; i < n; ++i) {
-        if (keep[i] && !in_layer[i] && range[i].min > layer_max) keep[i] = false;
-      }
+  bool in_layer[kMaxFragmentsPerPixel];
+  const FrontLayer layer = find_front_layer(
+      n, range, cov, keep,
+      [&](int i, int j) {
+        return layer_neighbours(tri(i), merged(i), range[i], tri(j), merged(j), range[j]);
+      },
+      in_layer);
+  if (layer.members > 0 && layer.coverage >= std::uint32_t(kCoverageOne)) {
+    for (int i = 0; i < n; ++i) {
+      if (keep[i] && !in_layer[i] && range[i].min > layer.max_depth) keep[i] = false;
     }
   }
   int kept = 0;
@@ -467,9 +515,9 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   // 5. Many different surfaces in one pixel: keep the larger areas.
   int smallest = 0;
   for (int i = 1; i < n; ++i) {
-    if (value(i) < value(smallest)) smallest = i;
+    if (cov[i] < cov[smallest]) smallest = i;
   }
-  if (coverage > value(smallest)) {
+  if (coverage > cov[smallest]) {
     pool_[id[smallest]].triangle = t;
     pool_[id[smallest]].coverage = coverage;
   }
@@ -523,9 +571,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
                                      float& depth) {
   const double cx = x + 0.5, cy = y + 0.5;
   const TriangleSetup* opaque = opaque_[pixel];
-  const glm::vec3 behind = opaque != nullptr ? shade(*opaque, cx, cy, true) : background;
-  depth =
-      opaque != nullptr ? float(opaque->depth_at(cx, cy)) : std::numeric_limits<float>::infinity();
+  const glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
   if (head_[pixel] == kEnd) return behind;
 
   const DepthRange opaque_range =
@@ -538,10 +584,8 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     const TriangleSetup* t = pool_[f].triangle;
-    // Range over the pixel from the centre: z(centre) -+ (|dz/dx| + |dz/dy|) / 2.
     const double centre_z = t->depth_at(cx, cy);
-    const double reach = 0.5 * (std::fabs(t->dzdx) + std::fabs(t->dzdy));
-    const DepthRange r{centre_z - reach, centre_z + reach};
+    const DepthRange r = range_around(*t, centre_z);
     if (opaque != nullptr) {
       DepthOrder order = r.max < opaque_range.min    ? DepthOrder::InFront
                          : r.min >= opaque_range.max ? DepthOrder::Behind
@@ -567,28 +611,11 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
                             range[j]);
   };
-  int nearest = 0;
-  for (int i = 1; i < n; ++i) {
-    if (range[i].min < range[nearest].min) nearest = i;
-  }
-  bool in_front[kMaxFragmentsPerPixel] = {};
-  int stack[kMaxFragmentsPerPixel];
-  int top = 0, members = 1;
-  in_front[nearest] = true;
-  stack[top++] = nearest;
-  std::uint32_t front_coverage = cov[nearest];
-  double front_max = range[nearest].max;
-  while (top > 0) {
-    const int m = stack[--top];
-    for (int j = 0; j < n; ++j) {
-      if (in_front[j] || !connected(m, j)) continue;
-      in_front[j] = true;
-      stack[top++] = j;
-      ++members;
-      front_coverage += cov[j];
-      front_max = std::max(front_max, range[j].max);
-    }
-  }
+  bool in_front[kMaxFragmentsPerPixel];
+  const FrontLayer front = find_front_layer(n, range, cov, nullptr, connected, in_front);
+  const int members = front.members;
+  const std::uint32_t front_coverage = front.coverage;
+  const double front_max = front.max_depth;
   bool front_separate = !crossing;
   for (int j = 0; j < n && front_separate; ++j) {
     if (!in_front[j] && !(front_max < range[j].min)) front_separate = false;
@@ -717,9 +744,8 @@ void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelR
   for (int y = r.y0; y < r.y1; ++y) {
     const std::size_t row = std::size_t(y - rect_.y0) * stride_;
     for (int x = r.x0; x < r.x1; ++x) {
-      const double cx = x + 0.5, cy = y + 0.5;
-      color_[row + (x - rect_.x0)] = shade(*opaque, cx, cy, true);
-      depth_[row + (x - rect_.x0)] = float(opaque->depth_at(cx, cy));
+      color_[row + (x - rect_.x0)] =
+          opaque_pixel(opaque, x, y, target.background_linear, depth_[row + (x - rect_.x0)]);
     }
   }
   const std::size_t first = std::size_t(r.y0 - rect_.y0) * stride_ + (r.x0 - rect_.x0);
@@ -756,12 +782,8 @@ void ABufferTile::resolve(const FrameTarget& target) {
           }
           if (head_[pixel] == kEnd) {
             // No fragments: the opaque surface or the background, as resolve_pixel gives it.
-            const TriangleSetup* opaque = opaque_[pixel];
-            const double cx = x + 0.5, cy = y + 0.5;
             color_[pixel] =
-                opaque != nullptr ? shade(*opaque, cx, cy, true) : target.background_linear;
-            depth_[pixel] = opaque != nullptr ? float(opaque->depth_at(cx, cy))
-                                              : std::numeric_limits<float>::infinity();
+                opaque_pixel(opaque_[pixel], x, y, target.background_linear, depth_[pixel]);
             continue;
           }
           color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);

@@ -66,13 +66,14 @@ class ABufferTile {
   /// Coverage 8.8 (kCoverageOne = full) of triangle `t` at pixel (x, y) of this tile, which
   /// prepare_row() has made ready; `centre_z` is t->depth_at(x + 0.5, y + 0.5), bit for bit.
   inline void add(int x, int y, const TriangleSetup* t, std::uint32_t coverage, double centre_z);
-  /// Whole-tile fast path for a triangle that covers every pixel of the tile: while every
-  /// pixel still shows one opaque triangle (or the background) and nothing else, the new
-  /// plane is compared with that one once, at the tile's corners (their difference is
-  /// affine, so extreme there), instead of pixel by pixel. Returns false when it cannot
-  /// decide (planes too close or crossing, or the tile is no longer uniform); the caller
-  /// then adds the triangle pixel by pixel, which gives what this would have.
-  bool add_covering_tile(const TriangleSetup* t);
+  /// Whole-tile fast path for triangle `t` (its pixels `r` clipped to the tile): when it
+  /// covers every pixel of the tile and every pixel still shows one opaque triangle (or the
+  /// background) and nothing else, the new plane is compared with that one once, at the
+  /// tile's corners (their difference is affine, so extreme there), instead of pixel by
+  /// pixel. Returns false when it cannot decide (not covering, planes too close or crossing,
+  /// or the tile no longer uniform); the caller then adds the triangle pixel by pixel, which
+  /// gives what this would have.
+  bool add_covering_tile(const TriangleSetup& t, const PixelRect& r);
   /// The same per block of 8x8 pixels: for every block of the tile that meets `r` and that
   /// `t` covers completely, while the block still shows one opaque triangle. Returns whether
   /// any block was decided; the caller skips their pixels (block_decided).
