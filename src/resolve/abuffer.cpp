@@ -10,6 +10,8 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <cstddef>
+#include <cstring>
 #include <limits>
 
 namespace covrast::detail {
@@ -41,18 +43,6 @@ DepthRange depth_range(const TriangleSetup& t, int x, int y) {
 
 bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
   return a.surface == b.surface && a.front_facing == b.front_facing;
-}
-
-/// Adjacent pieces of a conforming tessellation share a vertex (an edge, or a fan's centre).
-/// A fold of one mesh over itself shares none with what it covers, or, folded over a shared
-/// edge, has the opposite facing.
-bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      if (a.x_fx8[i] == b.x_fx8[j] && a.y_fx8[i] == b.y_fx8[j]) return true;
-    }
-  }
-  return false;
 }
 
 /// Pixel (x, y) showing `opaque` (null: the background) alone: its colour, and its window
@@ -524,47 +514,17 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   return true;
 }
 
-inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                                     std::uint32_t coverage, double centre_z) {
-  const std::uint32_t key = t->surface * 2 + (t->front_facing ? 1 : 0);
-  LayerSums& sums = layer_sums_[pixel];
-  if (layer_[pixel] == Layer::Empty) {
-    layer_[pixel] = Layer::One;
-    sums.key = key;
-    sums.coverage = 0;
-    sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
-    sums.depth = std::numeric_limits<float>::infinity();
-  } else if (layer_[pixel] == Layer::Mixed) {
-    return;
-  } else if (sums.key != key || !(share_vertex(*t, *pool_[tail_[pixel]].triangle) ||
-                                  share_vertex(*t, *pool_[head_[pixel]].triangle))) {
-    layer_[pixel] = Layer::Mixed;
-    return;
+bool ABufferTile::joins_list(std::size_t pixel, const TriangleSetup& t) const {
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (share_vertex(t, *pool_[f].triangle)) return true;
   }
-  const glm::vec3 c = shade(*t, x + 0.5, y + 0.5, true);
-  sums.coverage += coverage;
-  sums.rgb[0] += double(coverage) * c.r;
-  sums.rgb[1] += double(coverage) * c.g;
-  sums.rgb[2] += double(coverage) * c.b;
-  sums.depth = std::min(sums.depth, float(centre_z));
+  return false;
 }
 
-void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                               std::uint32_t coverage, double centre_z) {
-  if (count_[pixel] >= capacity_) {
-    layer_[pixel] = Layer::Mixed;  // merges and drops: only the list knows
-    if (handle_overflow(pixel, x, y, t, coverage)) return;
-  }
-  track_layer(pixel, x, y, t, coverage, centre_z);
-  std::uint32_t index = std::uint32_t(pool_.size());
-  pool_.push_back(Fragment{t, kEnd, coverage});
-  if (head_[pixel] == kEnd) {
-    head_[pixel] = index;
-  } else {
-    pool_[tail_[pixel]].next = index;
-  }
-  tail_[pixel] = index;
-  ++count_[pixel];
+bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                    std::uint32_t coverage) {
+  layer_[pixel] = Layer::Mixed;  // merges and drops: only the list knows
+  return handle_overflow(pixel, x, y, t, coverage);
 }
 
 glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
@@ -624,7 +584,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   if (front_separate && (members == n || front_coverage >= std::uint32_t(kCoverageOne))) {
     // One surface in front of everything else in this pixel: its exact areas add, and when
     // they fill the pixel nothing behind shows.
-    LayerSums sums{0, 0, {0.0, 0.0, 0.0}, depth};
+    LayerSums sums{0, 0, {0.0, 0.0, 0.0}, depth, nullptr, nullptr};
     for (int i = 0; i < n; ++i) {
       if (!in_front[i]) continue;
       const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);

@@ -22,10 +22,14 @@
 
 #include "geometry/triangle_setup.hpp"
 #include "raster/coverage_kernel.hpp"
+#include "raster/shading.hpp"
 #include "raster/tile_raster.hpp"
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
+#include <limits>
 #include <vector>
 
 namespace covrast::detail {
@@ -45,6 +49,25 @@ inline constexpr int kAbufferBlockPx = 8;
 
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
+
+/// Adjacent pieces of a conforming tessellation share a vertex (an edge, or a fan's centre).
+/// A fold of one mesh over itself shares none with what it covers, or, folded over a shared
+/// edge, has the opposite facing. It runs for every fragment (the one-layer test), so it
+/// compares b's vertices with all of a's at once, in 4-lane integer vectors (GCC/Clang vector
+/// extensions: SSE2 on x86-64, NEON on Arm), without a branch per pair.
+inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
+  using Lanes = std::int32_t __attribute__((vector_size(16)));
+  // a's x0 x1 x2 and y0 y1 y2 (the fourth lane is the next member's bytes, masked out below).
+  static_assert(offsetof(TriangleSetup, y_fx8) + sizeof(Lanes) <= sizeof(TriangleSetup));
+  const char* bytes = reinterpret_cast<const char*>(&a);
+  Lanes ax, ay;
+  std::memcpy(&ax, bytes + offsetof(TriangleSetup, x_fx8), sizeof(Lanes));
+  std::memcpy(&ay, bytes + offsetof(TriangleSetup, y_fx8), sizeof(Lanes));
+  const Lanes same = ((ax == b.x_fx8[0]) & (ay == b.y_fx8[0])) |
+                     ((ax == b.x_fx8[1]) & (ay == b.y_fx8[1])) |
+                     ((ax == b.x_fx8[2]) & (ay == b.y_fx8[2]));
+  return (same[0] | same[1] | same[2]) != 0;
+}
 
 /// Tests: resolve every pixel from its fragment list, never from the one-layer sums (the
 /// two must give the same bytes).
@@ -113,11 +136,16 @@ class ABufferTile {
   void split_tile();
   /// Leaves the block state: writes the block's opaque triangle into its pixels.
   void materialize_block(std::size_t b);
-  void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t, std::uint32_t coverage,
-                    double centre_z);
+  inline void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                           std::uint32_t coverage, double centre_z);
+  /// The list is full: the overflow policy (handle_overflow); true when `t` was absorbed.
+  bool overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                         std::uint32_t coverage);
   /// Keeps the running sums of a pixel whose fragments so far form one layer (see LayerSums).
   inline void track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
                           std::uint32_t coverage, double centre_z);
+  /// Whether `t` shares a vertex with any fragment in the pixel's list.
+  bool joins_list(std::size_t pixel, const TriangleSetup& t) const;
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
@@ -154,16 +182,22 @@ class ABufferTile {
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
   /// Per pixel, whether its fragments so far are one layer: all of one mesh instance and
-  /// facing, each sharing a vertex with the one before it or with the first (so the layer is
-  /// connected and its pieces do not overlap; the first helps where a tessellation's next row
-  /// of triangles starts). Such a pixel with no opaque surface resolves from the sums alone,
-  /// to exactly what the list would give (the front-layer formula of resolve_pixel).
+  /// facing, each sharing a vertex with one that came before it (so the layer is connected
+  /// and its pieces do not overlap). The one before it and the first are tried first (the
+  /// first helps where a tessellation's next row of triangles starts), the rest of the list
+  /// only when both fail (where dozens of triangles meet, e.g. at a sphere's pole). Such a
+  /// pixel with no opaque surface resolves from the sums alone, to exactly what the list
+  /// would give (the front-layer formula of resolve_pixel).
   enum class Layer : std::uint8_t { Empty, One, Mixed };
   struct LayerSums {
     std::uint32_t key;       ///< surface * 2 + front_facing
     std::uint32_t coverage;  ///< sum of the fragments' 8.8 coverage
     double rgb[3];           ///< sum of coverage * linear colour, in list order
     float depth;             ///< nearest centre depth
+    /// The layer's first and latest triangles (the list's head and tail, kept here so that
+    /// the join test reads them without going through the list).
+    const TriangleSetup* first;
+    const TriangleSetup* last;
   };
   /// Colour of a layer in front of everything else (abuffer.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
@@ -227,6 +261,48 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
     }
   }
   add_fragment(pixel, x, y, t, coverage, centre_z);
+}
+
+inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                     std::uint32_t coverage, double centre_z) {
+  const std::uint32_t key = t->surface * 2 + (t->front_facing ? 1 : 0);
+  LayerSums& sums = layer_sums_[pixel];
+  if (layer_[pixel] == Layer::Empty) {
+    layer_[pixel] = Layer::One;
+    sums.key = key;
+    sums.coverage = 0;
+    sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
+    sums.depth = std::numeric_limits<float>::infinity();
+    sums.first = t;
+  } else if (layer_[pixel] == Layer::Mixed) {
+    return;
+  } else if (sums.key != key || !(share_vertex(*t, *sums.last) || share_vertex(*t, *sums.first) ||
+                                  joins_list(pixel, *t))) {
+    layer_[pixel] = Layer::Mixed;
+    return;
+  }
+  sums.last = t;
+  const glm::vec3 c = shade(*t, x + 0.5, y + 0.5, true);
+  sums.coverage += coverage;
+  sums.rgb[0] += double(coverage) * c.r;
+  sums.rgb[1] += double(coverage) * c.g;
+  sums.rgb[2] += double(coverage) * c.b;
+  sums.depth = std::min(sums.depth, float(centre_z));
+}
+
+inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                      std::uint32_t coverage, double centre_z) {
+  if (count_[pixel] >= capacity_ && overflow_fragment(pixel, x, y, t, coverage)) return;
+  track_layer(pixel, x, y, t, coverage, centre_z);
+  std::uint32_t index = std::uint32_t(pool_.size());
+  pool_.push_back(Fragment{t, kEnd, coverage});
+  if (head_[pixel] == kEnd) {
+    head_[pixel] = index;
+  } else {
+    pool_[tail_[pixel]].next = index;
+  }
+  tail_[pixel] = index;
+  ++count_[pixel];
 }
 
 }  // namespace covrast::detail
