@@ -2,6 +2,9 @@
 //   kernel/coverage/scalar/<size>          coverage_rows_scalar, the reference twin
 //   kernel/coverage/simd:<target>/<size>   coverage_rows_simd forced to each Highway target
 //                                          compiled in and supported by this CPU
+//   kernel/coverage_group/<impl>/<size>    CoverGroupFn, the coverage mode's whole per-group
+//                                          step (set-up and rows): cover_group_scalar, or
+//                                          cover_group_simd forced to each target
 //   kernel/sample/<mode>/<impl>            SampleGroupFn, the per-group inner loop of the
 //                                          sample modes (<mode> msaa:4, msaa:16, ssaa:4,
 //                                          ssaa:16; <impl> scalar or simd:<target>)
@@ -12,7 +15,9 @@
 // The coverage kernel runs on realistic inputs: random triangles inside a 64 x 64 tile, set
 // up group by group of kColumnGroup columns exactly as the coverage rasterizer does, and the
 // kernel is called for the top and bottom partial runs of each group (the interior run needs
-// no kernel). <size> is "small" (1-8 px, like sphere_grid) or "large" (8-60 px).
+// no kernel). kernel/coverage_group runs the same groups from their triangles, set-up
+// included, as the rasterizer calls it. <size> is "small" (1-8 px, like sphere_grid) or
+// "large" (8-60 px).
 //
 // The sample kernels run on the product's patterns (msaa_pattern, ssaa_pattern), group
 // layout and bands (SampleRasterizer, 64 px tile, default band budget): 128 random
@@ -67,6 +72,8 @@ struct KernelJob {
   int sign = 1;
   int lanes = 0;  ///< columns of the group the triangle spans
   int first = 0, interior_begin = 0, interior_end = 0, end = 0;
+  CoverageTriangle tri{};  ///< the group's triangle, column and clip rows, for CoverGroupFn
+  int col = 0, row_min = 0, row_max = 0;
 };
 
 std::vector<KernelJob> make_kernel_jobs(double min_px, double max_px, std::uint32_t seed) {
@@ -90,6 +97,10 @@ std::vector<KernelJob> make_kernel_jobs(double min_px, double max_px, std::uint3
       job.columns = std::make_unique<CoverageColumns>();
       job.sign = tri.sign;
       job.lanes = std::min(kColumnGroup, r.x1 - g);
+      job.tri = tri;
+      job.col = g;
+      job.row_min = r.y0;
+      job.row_max = r.y1;
       const GroupRows rows = setup_column_group(tri, g, job.lanes, r.y0, r.y1, *job.columns);
       if (rows.empty()) continue;
       job.first = rows.first;
@@ -121,6 +132,33 @@ void run_kernel(benchmark::State& state, CoverageRowsFn kernel, std::int64_t tar
              plane.data() + std::size_t(job.first) * kStride, kStride);
       kernel(*job.columns, 0, job.interior_end, job.end, job.sign,
              plane.data() + std::size_t(job.interior_end) * kStride, kStride);
+    }
+    benchmark::DoNotOptimize(plane.data());
+    benchmark::ClobberMemory();
+  }
+  if (target != 0) force_coverage_kernel_target(0);
+  const double n = double(state.iterations());
+  state.counters["columns/s"] =
+      benchmark::Counter(n * double(columns), benchmark::Counter::kIsRate);
+  state.counters["pixels/s"] = benchmark::Counter(n * double(pixels), benchmark::Counter::kIsRate);
+}
+
+void run_cover_group(benchmark::State& state, CoverGroupFn fn, std::int64_t target, double min_px,
+                     double max_px) {
+  if (target != 0) force_coverage_kernel_target(target);
+  state.SetLabel(target != 0 ? coverage_kernel_target_name() : "scalar");
+  const std::vector<KernelJob> jobs = make_kernel_jobs(min_px, max_px, 1234);
+  constexpr std::size_t kStride = kColumnGroup * 2;
+  std::vector<std::uint16_t> plane(std::size_t(kTilePx) * kStride);
+  std::uint64_t columns = 0, pixels = 0;
+  for (const KernelJob& job : jobs) {
+    columns += std::uint64_t(job.lanes);
+    pixels += std::uint64_t(job.lanes) * std::uint64_t(job.end - job.first);
+  }
+  for (auto _ : state) {
+    for (const KernelJob& job : jobs) {
+      fn(job.tri, job.col, job.lanes, job.row_min, job.row_max,
+         plane.data() + std::size_t(job.row_min) * kStride, kStride);
     }
     benchmark::DoNotOptimize(plane.data());
     benchmark::ClobberMemory();
@@ -707,6 +745,25 @@ void register_all() {
           ("kernel/coverage/simd:" + std::string(hwy::TargetName(target)) + "/" + s.name).c_str(),
           [s, target](benchmark::State& state) {
             run_kernel(state, coverage_rows_simd, target, s.min_px, s.max_px);
+          })
+          ->UseRealTime();
+    }
+  }
+  for (const Size& s : sizes) {
+    benchmark::RegisterBenchmark(("kernel/coverage_group/scalar/" + std::string(s.name)).c_str(),
+                                 [s](benchmark::State& state) {
+                                   run_cover_group(state, cover_group_scalar, 0, s.min_px,
+                                                   s.max_px);
+                                 })
+        ->UseRealTime();
+    const std::int64_t usable = coverage_kernel_targets() & hwy::SupportedTargets();
+    for (std::int64_t bits = usable; bits != 0; bits &= bits - 1) {
+      const std::int64_t target = bits & -bits;
+      benchmark::RegisterBenchmark(
+          ("kernel/coverage_group/simd:" + std::string(hwy::TargetName(target)) + "/" + s.name)
+              .c_str(),
+          [s, target](benchmark::State& state) {
+            run_cover_group(state, cover_group_simd, target, s.min_px, s.max_px);
           })
           ->UseRealTime();
     }

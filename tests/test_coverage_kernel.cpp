@@ -3,10 +3,12 @@
 // bit identity of the SIMD kernel on every target this CPU runs with the scalar twin, and exact
 // sums (kCoverageOne) over tessellations. Also the set-up's fast paths against their
 // references: the vertex sorting network against std::sort, and the SIMD column set-up on
-// every target against its scalar twin (all five arrays, all lanes, the group's rows).
-// The helpers drive the kernel the way CoverageRasterizer::draw (src/raster/coverage.cpp)
-// does: groups of kColumnGroup columns, lanes past the span zeroed, kernel on the partial
-// runs and the piece width on the interior.
+// every target against its scalar twin (all five arrays, all lanes, the group's rows), and
+// the fused group function (set-up and rows in one call, the product's path) on every
+// target against the composition of the scalar twins. The helpers drive the kernel the
+// way CoverageRasterizer::draw (src/raster/coverage.cpp) does: groups of kColumnGroup
+// columns, lanes past the span zeroed, kernel on the partial runs and the piece width on
+// the interior.
 #include "geometry/triangle_setup.hpp"
 #include "raster/coverage_kernel.hpp"
 
@@ -36,6 +38,7 @@ using covrast::detail::ColumnRows;
 using covrast::detail::CoverageColumns;
 using covrast::detail::CoverageRowsFn;
 using covrast::detail::CoverageTriangle;
+using covrast::detail::CoverGroupFn;
 using covrast::detail::kColumnGroup;
 using covrast::detail::kCoverageOne;
 using covrast::detail::kSubpixelOne;
@@ -150,6 +153,7 @@ struct KernelRun {
   CoveragePlane plane;
   int sign = 0;
   std::uint64_t nonzero_beyond_span = 0;  ///< kernel output != 0 in a zeroed lane
+  std::uint64_t rows_mismatch = 0;        ///< groups whose rows differ from the scalar set-up's
 };
 
 /// Runs make_coverage_triangle + the column set-up + `fn` over `window` ∩ the triangle's box.
@@ -198,6 +202,44 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
       copy_end = end;
     }
     for (int y = copy_begin; y < copy_end; ++y) {
+      for (int lane = 0; lane < kColumnGroup; ++lane) {
+        const std::uint16_t v = buf[std::size_t(y - r.y0) * kColumnGroup + lane];
+        if (lane < lanes) {
+          run.plane.at(g + lane, y) = v;
+        } else if (v != 0) {
+          ++run.nonzero_beyond_span;
+        }
+      }
+    }
+  }
+  return run;
+}
+
+/// Runs make_coverage_triangle + `fn` over `window` ∩ the triangle's box exactly as
+/// CoverageRasterizer::draw does (one call per group, output at row r.y0), keeping rows
+/// [first, end) of each group; also compares each group's rows with the scalar set-up's.
+KernelRun run_group(const TriangleSetup& t, const PixelRect& window, CoverGroupFn fn) {
+  static thread_local std::unique_ptr<CoverageColumns> cols_ptr =
+      std::make_unique<CoverageColumns>();
+  KernelRun run;
+  run.plane.rect = window;
+  run.plane.cov.assign(std::size_t(window.x1 - window.x0) * std::size_t(window.y1 - window.y0), 0);
+  const PixelRect r = covrast::detail::intersect(covrast::detail::touched_pixels(t), window);
+  const CoverageTriangle tri = covrast::detail::make_coverage_triangle(t);
+  run.sign = tri.sign;
+  if (r.empty()) return run;
+  std::vector<std::uint16_t> buf(std::size_t(r.y1 - r.y0) * kColumnGroup);
+  for (int g = r.x0; g < r.x1; g += kColumnGroup) {
+    const int lanes = std::min(kColumnGroup, r.x1 - g);
+    // Poison the buffer: a row of [first, end) that nothing writes shows up as a mismatch.
+    std::fill(buf.begin(), buf.end(), kPoison);
+    const covrast::detail::GroupRows rows = fn(tri, g, lanes, r.y0, r.y1, buf.data(), kColumnGroup);
+    const covrast::detail::GroupRows ref =
+        covrast::detail::setup_column_group_scalar(tri, g, lanes, r.y0, r.y1, *cols_ptr);
+    run.rows_mismatch += rows.first != ref.first || rows.end != ref.end ||
+                         rows.interior_begin != ref.interior_begin ||
+                         rows.interior_end != ref.interior_end;
+    for (int y = rows.first; y < rows.end; ++y) {
       for (int lane = 0; lane < kColumnGroup; ++lane) {
         const std::uint16_t v = buf[std::size_t(y - r.y0) * kColumnGroup + lane];
         if (lane < lanes) {
@@ -361,7 +403,8 @@ constexpr KindCount kMix[] = {{Kind::Ordinary, 40000},
 TEST_CASE("coverage kernel matches the exact area of triangle and pixel", "[coverage]") {
   const auto start = std::chrono::steady_clock::now();
   TriangleGenerator gen(0x5eedc0feu);
-  std::uint64_t pixels = 0, triangles = 0, bad_alpha = 0, draw_mismatch = 0, beyond_span = 0;
+  std::uint64_t pixels = 0, triangles = 0, bad_alpha = 0, draw_mismatch = 0, beyond_span = 0,
+                rows_mismatch = 0;
   std::uint64_t signs[2] = {0, 0};
   double max_err_q = 0, sum_err_q = 0, sum_err_alpha = 0, sum_err_rounded = 0;
   int max_err_alpha_rounded = 0;
@@ -370,12 +413,12 @@ TEST_CASE("coverage kernel matches the exact area of triangle and pixel", "[cove
     for (int n = 0; n < kc.count; ++n) {
       const TestTriangle tt = gen.next(kc.kind);
       const TriangleSetup& t = tt.setup;
-      // The SIMD kernel as draw() drives it, and the scalar twin on every row.
-      const KernelRun simd =
-          run_kernel(t, tt.window, covrast::detail::coverage_rows_simd, RowMode::LikeDraw);
+      // The fused SIMD group function as draw() drives it, and the scalar twin on every row.
+      const KernelRun simd = run_group(t, tt.window, covrast::detail::cover_group_simd);
       const KernelRun all =
           run_kernel(t, tt.window, covrast::detail::coverage_rows_scalar, RowMode::AllRows);
       beyond_span += simd.nonzero_beyond_span + all.nonzero_beyond_span;
+      rows_mismatch += simd.rows_mismatch;
       ++signs[simd.sign > 0 ? 1 : 0];
       ++triangles;
       const PixelRect r = covrast::detail::intersect(covrast::detail::touched_pixels(t), tt.window);
@@ -434,6 +477,7 @@ TEST_CASE("coverage kernel matches the exact area of triangle and pixel", "[cove
   CHECK(signs[0] > 10000);
   CHECK(signs[1] > 10000);
   CHECK(beyond_span == 0);
+  CHECK(rows_mismatch == 0);
   CHECK(draw_mismatch == 0);
   CHECK(bad_alpha == 0);
   // Three edge terms, each rounded (1/2 unit) with float error far below a unit, plus the
@@ -471,34 +515,68 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
         run_kernel(tt.setup, tt.window, covrast::detail::coverage_rows_scalar, RowMode::AllRows));
   }
 
-  for (std::int64_t target : targets) {
-    covrast::detail::force_coverage_kernel_target(target);
-    INFO("target " << hwy::TargetName(target));
-    CHECK(std::string(covrast::detail::coverage_kernel_target_name()) == hwy::TargetName(target));
-    std::uint64_t differing_pixels = 0, beyond = 0;
+  // The separate kernel on all rows and as draw drove it, and the fused group function
+  // (the product's path; its scalar twin once, before any target is forced).
+  enum class Path { KernelAllRows, KernelLikeDraw, Fused, FusedScalar };
+  auto run_path = [](const TestTriangle& tt, Path path) {
+    switch (path) {
+      case Path::KernelAllRows:
+        return run_kernel(tt.setup, tt.window, covrast::detail::coverage_rows_simd,
+                          RowMode::AllRows);
+      case Path::KernelLikeDraw:
+        return run_kernel(tt.setup, tt.window, covrast::detail::coverage_rows_simd,
+                          RowMode::LikeDraw);
+      case Path::Fused:
+        return run_group(tt.setup, tt.window, covrast::detail::cover_group_simd);
+      case Path::FusedScalar:
+        break;
+    }
+    return run_group(tt.setup, tt.window, covrast::detail::cover_group_scalar);
+  };
+  struct Mismatch {
+    std::uint64_t pixels = 0, beyond = 0, rows = 0;
     std::string first;
+  };
+  auto compare = [&](std::initializer_list<Path> paths) {
+    Mismatch m;
     for (std::size_t i = 0; i < tris.size(); ++i) {
-      for (RowMode mode : {RowMode::AllRows, RowMode::LikeDraw}) {
-        const KernelRun simd =
-            run_kernel(tris[i].setup, tris[i].window, covrast::detail::coverage_rows_simd, mode);
-        beyond += simd.nonzero_beyond_span;
+      for (Path path : paths) {
+        const KernelRun simd = run_path(tris[i], path);
+        m.beyond += simd.nonzero_beyond_span;
+        m.rows += simd.rows_mismatch;
         for (std::size_t p = 0; p < simd.plane.cov.size(); ++p) {
           if (simd.plane.cov[p] == scalar[i].plane.cov[p]) continue;
-          if (++differing_pixels == 1) {
+          if (++m.pixels == 1) {
             std::ostringstream s;
             const int w = tris[i].window.x1 - tris[i].window.x0;
-            s << kind_name(tris[i].kind) << " " << describe(tris[i].setup) << " pixel ("
+            s << "path " << int(path) << ": " << kind_name(tris[i].kind) << " "
+              << describe(tris[i].setup) << " pixel ("
               << tris[i].window.x0 + int(p % std::size_t(w)) << ", "
               << tris[i].window.y0 + int(p / std::size_t(w)) << "): simd " << simd.plane.cov[p]
               << ", scalar " << scalar[i].plane.cov[p];
-            first = s.str();
+            m.first = s.str();
           }
         }
       }
     }
-    INFO(first);
-    CHECK(differing_pixels == 0);
-    CHECK(beyond == 0);
+    return m;
+  };
+  {
+    const Mismatch m = compare({Path::FusedScalar});
+    INFO("cover_group_scalar: " << m.first);
+    CHECK(m.pixels == 0);
+    CHECK(m.beyond == 0);
+    CHECK(m.rows == 0);
+  }
+  for (std::int64_t target : targets) {
+    covrast::detail::force_coverage_kernel_target(target);
+    INFO("target " << hwy::TargetName(target));
+    CHECK(std::string(covrast::detail::coverage_kernel_target_name()) == hwy::TargetName(target));
+    const Mismatch m = compare({Path::KernelAllRows, Path::KernelLikeDraw, Path::Fused});
+    INFO(m.first);
+    CHECK(m.pixels == 0);
+    CHECK(m.beyond == 0);
+    CHECK(m.rows == 0);
   }
   covrast::detail::force_coverage_kernel_target(0);
   CHECK(hwy::SupportedTargets() == supported);
@@ -890,13 +968,14 @@ TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[c
 namespace {
 
 struct TessellationResult {
-  std::uint64_t full_pixels = 0;  ///< pixels whose exact covered area is 1
-  std::uint64_t wrong = 0;        ///< of those, pixels whose 8.8 sum is not kCoverageOne
-  std::uint64_t over = 0;         ///< any pixel whose 8.8 sum exceeds kCoverageOne
+  std::uint64_t full_pixels = 0;    ///< pixels whose exact covered area is 1
+  std::uint64_t wrong = 0;          ///< of those, pixels whose 8.8 sum is not kCoverageOne
+  std::uint64_t over = 0;           ///< any pixel whose 8.8 sum exceeds kCoverageOne
+  std::uint64_t rows_mismatch = 0;  ///< groups whose rows differ from the scalar set-up's
   std::string first_wrong;
 };
 
-/// Sums the 8.8 coverage of all triangles per pixel (as draw() computes it, SIMD kernel)
+/// Sums the 8.8 coverage of all triangles per pixel (as draw() computes it, cover_group_simd)
 /// and checks pixels whose exact covered area is 1.
 TessellationResult check_tessellation(const std::vector<TriangleSetup>& tris) {
   PixelRect box{INT32_MAX, INT32_MAX, INT32_MIN, INT32_MIN};
@@ -909,9 +988,10 @@ TessellationResult check_tessellation(const std::vector<TriangleSetup>& tris) {
   std::vector<std::uint32_t> sum(w * h, 0);
   std::vector<double> exact(w * h, 0.0);
   std::vector<std::vector<std::pair<std::size_t, std::uint16_t>>> parts(w * h);
+  TessellationResult res;
   for (std::size_t i = 0; i < tris.size(); ++i) {
-    const KernelRun run =
-        run_kernel(tris[i], box, covrast::detail::coverage_rows_simd, RowMode::LikeDraw);
+    const KernelRun run = run_group(tris[i], box, covrast::detail::cover_group_simd);
+    res.rows_mismatch += run.rows_mismatch;
     const PixelRect r = covrast::detail::touched_pixels(tris[i]);
     for (int y = r.y0; y < r.y1; ++y) {
       for (int x = r.x0; x < r.x1; ++x) {
@@ -923,7 +1003,6 @@ TessellationResult check_tessellation(const std::vector<TriangleSetup>& tris) {
       }
     }
   }
-  TessellationResult res;
   for (std::size_t p = 0; p < w * h; ++p) {
     if (sum[p] > std::uint32_t(kCoverageOne)) ++res.over;
     if (std::fabs(exact[p] - 1.0) > 1e-9) continue;
@@ -1079,6 +1158,7 @@ TEST_CASE("coverage of a tessellation adds up to exactly one pixel", "[coverage]
     CHECK(res.full_pixels > 50);
     CHECK(res.wrong == 0);
     CHECK(res.over == 0);
+    CHECK(res.rows_mismatch == 0);
     summary << c.name << ": " << res.full_pixels << " full pixels, " << res.wrong << " wrong; ";
   }
   WARN("tessellations: " << summary.str());

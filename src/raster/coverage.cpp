@@ -34,7 +34,6 @@ class CoverageRasterizer final : public TileRasterizer {
         blend_(blend),
         plane_stride_(std::size_t(tile_px) + kColumnGroup),
         plane_(std::size_t(tile_px) * plane_stride_),
-        columns_(std::make_unique<CoverageColumns>()),
         abuffer_(blend ? 1 : tile_px) {
     if (blend_) {
       color_.resize(std::size_t(tile_px) * tile_px);
@@ -63,32 +62,16 @@ class CoverageRasterizer final : public TileRasterizer {
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
     }
     const CoverageTriangle tri = make_coverage_triangle(t);
-    CoverageColumns& cols = *columns_;
     // With decided blocks, column groups line up with the blocks, so that a row of a group
     // lies in one block (columns left of the triangle get zero coverage).
     const int g0 = skip_decided ? rect_.x0 + (r.x0 - rect_.x0) / kColumnGroup * kColumnGroup : r.x0;
+    std::uint16_t* const out = plane_.data() + std::size_t(r.y0 - rect_.y0) * plane_stride_;
     for (int g = g0; g < r.x1; g += kColumnGroup) {
       const int lanes = std::min(kColumnGroup, r.x1 - g);
-      const GroupRows rows = setup_column_group(tri, g, lanes, r.y0, r.y1, cols);
+      // Top partial run, interior run, bottom partial run of the group, in the plane.
+      const GroupRows rows = cover_group_(tri, g, lanes, r.y0, r.y1, out, plane_stride_);
       if (rows.empty()) continue;
       const int first = rows.first, end = rows.end;
-      const int interior_begin = rows.interior_begin, interior_end = rows.interior_end;
-      std::uint16_t* out = plane_.data() + std::size_t(first - rect_.y0) * plane_stride_;
-      if (interior_begin == interior_end) {
-        // No interior run (small triangles): one kernel call for all rows.
-        kernel_(cols, 0, first, end, tri.sign, out, plane_stride_);
-      } else {
-        // Top partial run, interior run, bottom partial run.
-        kernel_(cols, 0, first, interior_begin, tri.sign, out, plane_stride_);
-        for (int y = interior_begin; y < interior_end; ++y) {
-          std::uint16_t* row = plane_.data() + std::size_t(y - rect_.y0) * plane_stride_;
-          for (int lane = 0; lane < kColumnGroup; ++lane)
-            row[lane] = std::uint16_t(cols.width_q[0][lane]);
-        }
-        kernel_(cols, 0, interior_end, end, tri.sign,
-                plane_.data() + std::size_t(interior_end - rect_.y0) * plane_stride_,
-                plane_stride_);
-      }
       consume(t, g, lanes, first, end, skip_decided);
     }
   }
@@ -105,14 +88,13 @@ class CoverageRasterizer final : public TileRasterizer {
   }
 
   std::size_t scratch_bytes() const override {
-    return plane_.size() * sizeof(std::uint16_t) + sizeof(CoverageColumns) +
-           color_.size() * sizeof(glm::vec3) + depth_.size() * sizeof(float) +
-           abuffer_.scratch_bytes();
+    return plane_.size() * sizeof(std::uint16_t) + color_.size() * sizeof(glm::vec3) +
+           depth_.size() * sizeof(float) + abuffer_.scratch_bytes();
   }
   std::uint64_t overflow_count() const override { return abuffer_.overflow_count(); }
 
-  /// Kernel used for the partial runs; tests swap in the scalar twin.
-  CoverageRowsFn kernel_ = coverage_rows_simd;
+  /// The per-group set-up and kernel; tests swap in the scalar twin.
+  CoverGroupFn cover_group_ = cover_group_simd;
   /// The whole-tile and whole-block paths; tests turn them off to compare.
   bool fast_paths_ = !g_pixel_path_only.load(std::memory_order_relaxed);
 
@@ -163,7 +145,6 @@ class CoverageRasterizer final : public TileRasterizer {
   std::size_t plane_stride_;
   PixelRect rect_;
   std::vector<std::uint16_t> plane_;  ///< the alpha plane: 8.8 coverage per pixel of the span
-  std::unique_ptr<CoverageColumns> columns_;
   ABufferTile abuffer_;
   std::vector<glm::vec3> color_;  ///< coverage-blend: linear colour, r < 0 = background
   std::vector<float> depth_;      ///< coverage-blend: one depth per pixel

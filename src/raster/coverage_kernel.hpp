@@ -61,17 +61,21 @@ struct CoverageColumns {
 using CoverageRowsFn = void (*)(const CoverageColumns& columns, int col, int row_begin, int row_end,
                                 int sign, std::uint16_t* out, std::size_t stride);
 
-/// The scalar twin: the same operations in the same order, one column at a time.
+/// The scalar twin and reference: the formula above term by term, one column at a time.
 void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin, int row_end,
                           int sign, std::uint16_t* out, std::size_t stride);
 
-/// The SIMD kernel for the best target of this CPU (Highway dynamic dispatch).
+/// The SIMD kernel for the best target of this CPU (Highway dynamic dispatch), for tests
+/// and benchmarks (the coverage mode runs the same row math inside cover_group_simd). It
+/// gives the scalar twin's bits on inputs as the set-up makes them: slope_q the quotient
+/// width_q / (t_right - t_left) (or 0), width_q >= 0, rows and base rows below 2^23.
 void coverage_rows_simd(const CoverageColumns& columns, int col, int row_begin, int row_end,
                         int sign, std::uint16_t* out, std::size_t stride);
 
 /// Highway targets compiled into this build (bit flags, HWY_* values), for tests and
 /// benchmarks; and a way to force one (0 = back to the best supported). Forcing a target
-/// applies to every dispatched function of this header: the kernel and the column set-up.
+/// applies to every dispatched function of this header: the kernel, the column set-up and
+/// the fused group function.
 std::int64_t coverage_kernel_targets();
 void force_coverage_kernel_target(std::int64_t target);
 const char* coverage_kernel_target_name();
@@ -113,9 +117,10 @@ struct GroupRows {
 
 /// Sets up columns [col, col + kColumnGroup) of `tri` in `columns` (lanes from `lanes` on
 /// get zero width, so the kernel writes 0 there) and returns the group's rows clipped to
-/// [row_min, row_max). The one set-up loop of the coverage mode, its tests and benchmarks:
-/// the SIMD set-up for the best target of this CPU (Highway dynamic dispatch, all lanes of
-/// the group at once in double precision), bit-identical to setup_column_group_scalar.
+/// [row_min, row_max). The SIMD set-up for the best target of this CPU (Highway dynamic
+/// dispatch, the lanes of the group in double precision), bit-identical to
+/// setup_column_group_scalar; for tests and benchmarks (the coverage mode runs the same
+/// set-up inside cover_group_simd).
 GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, int row_min,
                              int row_max, CoverageColumns& columns);
 
@@ -123,6 +128,26 @@ GroupRows setup_column_group(const CoverageTriangle& tri, int col, int lanes, in
 /// same operations in the same order.
 GroupRows setup_column_group_scalar(const CoverageTriangle& tri, int col, int lanes, int row_min,
                                     int row_max, CoverageColumns& columns);
+
+/// The whole of one column group, the coverage mode's per-group step: the set-up of
+/// columns [col, col + kColumnGroup) as setup_column_group, then its rows as draw needs
+/// them: the kernel on the top partial run [first, interior_begin) and the bottom one
+/// [interior_end, end), the long edge's width_q on the interior run. Row y of the group
+/// goes to out[(y - row_min) * stride + (c - col)] for y in [first, end) of the returned
+/// rows (nothing is written when they are empty).
+using CoverGroupFn = GroupRows (*)(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                                   int row_max, std::uint16_t* out, std::size_t stride);
+
+/// The scalar twin and reference: setup_column_group_scalar, then coverage_rows_scalar on
+/// the partial runs and width_q[0] on the interior run.
+GroupRows cover_group_scalar(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                             int row_max, std::uint16_t* out, std::size_t stride);
+
+/// The fused SIMD version for the best target of this CPU (Highway dynamic dispatch): one
+/// call per group, the set-up kept in registers for the rows; bit-identical to
+/// cover_group_scalar.
+GroupRows cover_group_simd(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                           int row_max, std::uint16_t* out, std::size_t stride);
 
 /// The group's rows from the unclipped union over its columns (first = INT_MAX, end =
 /// INT_MIN when no column is touched): clipped to [row_min, row_max), interior run inside.

@@ -1,7 +1,7 @@
 // Raster stage, coverage mode: per-triangle and per-column set-up of the kernel's inputs,
 // in double precision from the snapped vertices (see coverage_kernel.hpp for the formula),
-// and the scalar twins of the SIMD column set-up and kernel (coverage_kernel.cpp), which
-// are the references those must match bit for bit.
+// and the scalar twins of the SIMD column set-up, kernel and fused group function
+// (coverage_kernel.cpp), which are the references those must match bit for bit.
 #include "raster/coverage_kernel.hpp"
 
 #include <algorithm>
@@ -12,12 +12,9 @@ namespace covrast::detail {
 namespace {
 
 CoverageEdge make_edge(double xa, double ya, double xb, double yb) {
-  // Canonical direction (left to right, then top to bottom) so that both triangles of a
-  // shared edge compute every term from the same numbers in the same order.
-  if (xb < xa || (xb == xa && yb < ya)) {
-    std::swap(xa, xb);
-    std::swap(ya, yb);
-  }
+  // The canonical direction (left to right, then top to bottom), so that both triangles of
+  // a shared edge compute every term from the same numbers in the same order: the caller
+  // passes the vertices in (x, y) order, so (xa, ya) <= (xb, yb) lexicographically.
   CoverageEdge e{xa, ya, xb, yb, 0.0};
   if (xb > xa) e.slope = (yb - ya) / (xb - xa);
   return e;
@@ -152,6 +149,24 @@ void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin
       out[c - col] = std::uint16_t(std::clamp(cov, 0, kCoverageOne));
     }
   }
+}
+
+GroupRows cover_group_scalar(const CoverageTriangle& tri, int col, int lanes, int row_min,
+                             int row_max, std::uint16_t* out, std::size_t stride) {
+  CoverageColumns columns;  // only lanes [0, kColumnGroup) are written and read
+  const GroupRows rows = setup_column_group_scalar(tri, col, lanes, row_min, row_max, columns);
+  if (rows.empty()) return rows;
+  auto row_out = [&](int y) { return out + std::size_t(y - row_min) * stride; };
+  coverage_rows_scalar(columns, 0, rows.first, rows.interior_begin, tri.sign, row_out(rows.first),
+                       stride);
+  for (int y = rows.interior_begin; y < rows.interior_end; ++y) {
+    for (int lane = 0; lane < kColumnGroup; ++lane) {
+      row_out(y)[lane] = std::uint16_t(columns.width_q[0][lane]);
+    }
+  }
+  coverage_rows_scalar(columns, 0, rows.interior_end, rows.end, tri.sign,
+                       row_out(rows.interior_end), stride);
+  return rows;
 }
 
 }  // namespace covrast::detail
