@@ -12,8 +12,9 @@
 
 namespace covrast::cli {
 
-/// The program version; must match project(covrast VERSION ...) in CMakeLists.txt.
-inline constexpr const char* kVersion = "0.1.0";
+/// The program version: project(covrast VERSION ...) in CMakeLists.txt, passed in by the
+/// build as COVRAST_VERSION.
+inline constexpr const char* kVersion = COVRAST_VERSION;
 
 struct RenderArgs {
   std::string scene;

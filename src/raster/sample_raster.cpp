@@ -7,6 +7,7 @@
 #include "resolve/srgb8.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdlib>
 #include <limits>
 
@@ -174,6 +175,7 @@ void SampleRasterizer::resolve_tile(const FrameTarget&) {
   }
   for (int b = 0; b < bands; ++b) {
     const int y0 = rect_.y0 + b * band_rows_, y1 = std::min(y0 + band_rows_, rect_.y1);
+    const auto raster_start = std::chrono::steady_clock::now();
     start_band(y0, y1);
     for (std::uint32_t k = band_begin_[std::size_t(b)]; k < band_begin_[std::size_t(b) + 1]; ++k) {
       const Pending& p = pending_[band_items_[k]];
@@ -182,6 +184,9 @@ void SampleRasterizer::resolve_tile(const FrameTarget&) {
       r.y1 = std::min(r.y1, y1);
       rasterize(*p.triangle, r);
     }
+    deferred_raster_ms_ +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - raster_start)
+            .count();
     resolve_band();
   }
 }

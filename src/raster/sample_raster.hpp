@@ -44,6 +44,7 @@ class SampleRasterizer final : public TileRasterizer {
   void draw(const TriangleSetup& triangle) override;
   void end_tile(const FrameTarget& target) override;
   std::size_t scratch_bytes() const override;
+  double deferred_raster_ms() const override { return deferred_raster_ms_; }
 
   /// What end_tile does before encoding: rasterizes what is pending and resolves the
   /// tile. Afterwards pixel (x, y) of the tile has linear colour
@@ -88,6 +89,7 @@ class SampleRasterizer final : public TileRasterizer {
   std::vector<glm::vec3> linear_;
   std::vector<float> pixel_depth_;
   std::vector<Pending> pending_;
+  double deferred_raster_ms_ = 0.0;  ///< replaying pending_ in end_tile, summed over tiles
   std::vector<std::uint32_t> band_begin_;
   std::vector<std::uint32_t> band_items_;
   std::vector<std::uint32_t> band_cursor_;

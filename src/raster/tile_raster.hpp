@@ -33,6 +33,10 @@ class TileRasterizer {
   virtual std::size_t scratch_bytes() const = 0;
   /// Fragments merged or dropped because a pixel's list was full (coverage mode).
   virtual std::uint64_t overflow_count() const { return 0; }
+  /// Time [ms] this instance has spent so far rasterising inside end_tile(): the banded
+  /// sample modes record a large tile's triangles and replay them band by band there
+  /// (sample_raster.cpp). The renderer counts it as raster time, not resolve time.
+  virtual double deferred_raster_ms() const { return 0.0; }
 };
 
 /// Largest tile side the rasterizers accept [pixels].
