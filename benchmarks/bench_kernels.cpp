@@ -113,12 +113,32 @@ std::vector<KernelJob> make_kernel_jobs(double min_px, double max_px, std::uint3
   return jobs;
 }
 
-void run_kernel(benchmark::State& state, CoverageRowsFn kernel, std::int64_t target, double min_px,
-                double max_px) {
+/// Output row stride of the coverage-kernel benchmarks [pixels].
+constexpr std::size_t kStride = kColumnGroup * 2;
+
+/// Starts a coverage-kernel benchmark: forces `target` (0: scalar), labels the run with it,
+/// and makes the fixed set of triangle groups it runs over.
+std::vector<KernelJob> start_kernel_run(benchmark::State& state, std::int64_t target, double min_px,
+                                        double max_px) {
   if (target != 0) force_coverage_kernel_target(target);
   state.SetLabel(target != 0 ? coverage_kernel_target_name() : "scalar");
-  const std::vector<KernelJob> jobs = make_kernel_jobs(min_px, max_px, 1234);
-  constexpr std::size_t kStride = kColumnGroup * 2;
+  return make_kernel_jobs(min_px, max_px, 1234);
+}
+
+/// Ends a coverage-kernel benchmark: the forced target back to the best one, and the rate
+/// counters from what one iteration computed.
+void finish_kernel_run(benchmark::State& state, std::int64_t target, std::uint64_t columns,
+                       std::uint64_t pixels) {
+  if (target != 0) force_coverage_kernel_target(0);
+  const double n = double(state.iterations());
+  state.counters["columns/s"] =
+      benchmark::Counter(n * double(columns), benchmark::Counter::kIsRate);
+  state.counters["pixels/s"] = benchmark::Counter(n * double(pixels), benchmark::Counter::kIsRate);
+}
+
+void run_kernel(benchmark::State& state, CoverageRowsFn kernel, std::int64_t target, double min_px,
+                double max_px) {
+  const std::vector<KernelJob> jobs = start_kernel_run(state, target, min_px, max_px);
   std::vector<std::uint16_t> plane(std::size_t(kTilePx) * kStride);
   std::uint64_t columns = 0, pixels = 0;
   for (const KernelJob& job : jobs) {
@@ -136,19 +156,12 @@ void run_kernel(benchmark::State& state, CoverageRowsFn kernel, std::int64_t tar
     benchmark::DoNotOptimize(plane.data());
     benchmark::ClobberMemory();
   }
-  if (target != 0) force_coverage_kernel_target(0);
-  const double n = double(state.iterations());
-  state.counters["columns/s"] =
-      benchmark::Counter(n * double(columns), benchmark::Counter::kIsRate);
-  state.counters["pixels/s"] = benchmark::Counter(n * double(pixels), benchmark::Counter::kIsRate);
+  finish_kernel_run(state, target, columns, pixels);
 }
 
 void run_cover_group(benchmark::State& state, CoverGroupFn fn, std::int64_t target, double min_px,
                      double max_px) {
-  if (target != 0) force_coverage_kernel_target(target);
-  state.SetLabel(target != 0 ? coverage_kernel_target_name() : "scalar");
-  const std::vector<KernelJob> jobs = make_kernel_jobs(min_px, max_px, 1234);
-  constexpr std::size_t kStride = kColumnGroup * 2;
+  const std::vector<KernelJob> jobs = start_kernel_run(state, target, min_px, max_px);
   std::vector<std::uint16_t> plane(std::size_t(kTilePx) * kStride);
   std::uint64_t columns = 0, pixels = 0;
   for (const KernelJob& job : jobs) {
@@ -163,11 +176,7 @@ void run_cover_group(benchmark::State& state, CoverGroupFn fn, std::int64_t targ
     benchmark::DoNotOptimize(plane.data());
     benchmark::ClobberMemory();
   }
-  if (target != 0) force_coverage_kernel_target(0);
-  const double n = double(state.iterations());
-  state.counters["columns/s"] =
-      benchmark::Counter(n * double(columns), benchmark::Counter::kIsRate);
-  state.counters["pixels/s"] = benchmark::Counter(n * double(pixels), benchmark::Counter::kIsRate);
+  finish_kernel_run(state, target, columns, pixels);
 }
 
 // ---------------------------------------------------------------------------------------

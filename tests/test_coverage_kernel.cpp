@@ -156,6 +156,31 @@ struct KernelRun {
   std::uint64_t rows_mismatch = 0;        ///< groups whose rows differ from the scalar set-up's
 };
 
+/// A run over `window` with every pixel's coverage 0.
+KernelRun empty_run(const PixelRect& window) {
+  KernelRun run;
+  run.plane.rect = window;
+  run.plane.cov.assign(std::size_t(window.x1 - window.x0) * std::size_t(window.y1 - window.y0), 0);
+  return run;
+}
+
+/// Copies rows [y_begin, y_end) of a group's output `buf` (row y at (y - buf_y0) *
+/// kColumnGroup) into run.plane, lanes [0, lanes) only, and counts non-zero values in the
+/// lanes beyond (the kernel must write 0 there).
+void keep_group_rows(const std::vector<std::uint16_t>& buf, int buf_y0, int g, int lanes,
+                     int y_begin, int y_end, KernelRun& run) {
+  for (int y = y_begin; y < y_end; ++y) {
+    for (int lane = 0; lane < kColumnGroup; ++lane) {
+      const std::uint16_t v = buf[std::size_t(y - buf_y0) * kColumnGroup + lane];
+      if (lane < lanes) {
+        run.plane.at(g + lane, y) = v;
+      } else if (v != 0) {
+        ++run.nonzero_beyond_span;
+      }
+    }
+  }
+}
+
 /// Runs make_coverage_triangle + the column set-up + `fn` over `window` ∩ the triangle's box.
 /// The scalar kernel runs with the scalar set-up (setup_column_group_scalar), so the
 /// reference is scalar end to end; any other kernel with the dispatched SIMD set-up, as draw.
@@ -164,9 +189,7 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
   static thread_local std::unique_ptr<CoverageColumns> cols_ptr =
       std::make_unique<CoverageColumns>();
   CoverageColumns& cols = *cols_ptr;
-  KernelRun run;
-  run.plane.rect = window;
-  run.plane.cov.assign(std::size_t(window.x1 - window.x0) * std::size_t(window.y1 - window.y0), 0);
+  KernelRun run = empty_run(window);
   const PixelRect r = covrast::detail::intersect(covrast::detail::touched_pixels(t), window);
   const CoverageTriangle tri = covrast::detail::make_coverage_triangle(t);
   run.sign = tri.sign;
@@ -201,16 +224,7 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
       copy_begin = first;
       copy_end = end;
     }
-    for (int y = copy_begin; y < copy_end; ++y) {
-      for (int lane = 0; lane < kColumnGroup; ++lane) {
-        const std::uint16_t v = buf[std::size_t(y - r.y0) * kColumnGroup + lane];
-        if (lane < lanes) {
-          run.plane.at(g + lane, y) = v;
-        } else if (v != 0) {
-          ++run.nonzero_beyond_span;
-        }
-      }
-    }
+    keep_group_rows(buf, r.y0, g, lanes, copy_begin, copy_end, run);
   }
   return run;
 }
@@ -221,9 +235,7 @@ KernelRun run_kernel(const TriangleSetup& t, const PixelRect& window, CoverageRo
 KernelRun run_group(const TriangleSetup& t, const PixelRect& window, CoverGroupFn fn) {
   static thread_local std::unique_ptr<CoverageColumns> cols_ptr =
       std::make_unique<CoverageColumns>();
-  KernelRun run;
-  run.plane.rect = window;
-  run.plane.cov.assign(std::size_t(window.x1 - window.x0) * std::size_t(window.y1 - window.y0), 0);
+  KernelRun run = empty_run(window);
   const PixelRect r = covrast::detail::intersect(covrast::detail::touched_pixels(t), window);
   const CoverageTriangle tri = covrast::detail::make_coverage_triangle(t);
   run.sign = tri.sign;
@@ -239,16 +251,7 @@ KernelRun run_group(const TriangleSetup& t, const PixelRect& window, CoverGroupF
     run.rows_mismatch += rows.first != ref.first || rows.end != ref.end ||
                          rows.interior_begin != ref.interior_begin ||
                          rows.interior_end != ref.interior_end;
-    for (int y = rows.first; y < rows.end; ++y) {
-      for (int lane = 0; lane < kColumnGroup; ++lane) {
-        const std::uint16_t v = buf[std::size_t(y - r.y0) * kColumnGroup + lane];
-        if (lane < lanes) {
-          run.plane.at(g + lane, y) = v;
-        } else if (v != 0) {
-          ++run.nonzero_beyond_span;
-        }
-      }
-    }
+    keep_group_rows(buf, r.y0, g, lanes, rows.first, rows.end, run);
   }
   return run;
 }
