@@ -447,10 +447,10 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
 
 // ---- 4. Resolve ---------------------------------------------------------------------------
 
-/// Tolerance against the 64 x 64-sample reference where the resolve uses its 8 x 8 sub-pixel
-/// masks, in linear light per channel. A straight edge through the 8 mask columns can
-/// misplace up to 1/8 of a pixel; fragments in these scenes stay within 1/32 (measured up
-/// to about 0.02). In 8-bit sRGB the same error reads large in dark channels (0.02 linear is
+/// Tolerance against the 64 x 64-sample reference where the resolve uses its 16 x 16 sub-pixel
+/// masks, in linear light per channel. A straight edge through the 16 mask columns can
+/// misplace up to 1/16 of a pixel; fragments in these scenes stay within 1/32 (measured up
+/// to about 0.018). In 8-bit sRGB the same error reads large in dark channels (0.02 linear is
 /// 39 codes at 0), so the 8-bit measure is reported, and bounded only on average.
 constexpr double kMaskToleranceLinear = 1.0 / 32.0;
 

@@ -1,4 +1,4 @@
-// Tests of the 8x8 sub-pixel sample mask of the coverage resolve (src/resolve/sample_mask.hpp):
+// Tests of the 16x16 sub-pixel sample mask of the coverage resolve (src/resolve/sample_mask.hpp):
 // masks computed by hand (ties of the top-left rule on sample columns and rows, a tiny
 // triangle around one sample, two triangles sharing a diagonal through samples), the scalar
 // reference against a direct per-sample evaluation, and every Highway target compiled and
@@ -27,13 +27,16 @@
 namespace {
 
 using covrast::detail::force_sample_mask_target;
+using covrast::detail::kMaskGridSide;
+using covrast::detail::kMaskSamples;
 using covrast::detail::kSubpixelOne;
 using covrast::detail::pixel_sample_mask;
 using covrast::detail::pixel_sample_mask_scalar;
+using covrast::detail::SampleMask;
 using covrast::detail::TriangleEdges;
 using covrast::detail::TriangleSetup;
 
-using MaskFn = std::uint64_t (*)(const TriangleSetup&, int, int);
+using MaskFn = SampleMask (*)(const TriangleSetup&, int, int);
 
 TriangleSetup make_triangle(std::int32_t x0, std::int32_t y0, std::int32_t x1, std::int32_t y1,
                             std::int32_t x2, std::int32_t y2) {
@@ -47,43 +50,53 @@ TriangleSetup make_triangle(std::int32_t x0, std::int32_t y0, std::int32_t x1, s
   return t;
 }
 
-/// Position of sample k (0..7) of pixel p along one axis [fx8]: p + (k + 0.5) / 8 pixels.
-constexpr std::int32_t sample_fx8(int p, int k) { return p * kSubpixelOne + 16 + 32 * k; }
+/// Position of sample k (0..15) of pixel p along one axis [fx8]: p + (k + 0.5) / 16 pixels.
+constexpr std::int32_t sample_fx8(int p, int k) { return p * kSubpixelOne + 8 + 16 * k; }
 
-/// The mask from the edge functions evaluated at every sample directly (no stepping).
-std::uint64_t direct_mask(const TriangleSetup& t, int x, int y) {
-  const TriangleEdges edges(t);
-  std::uint64_t mask = 0;
-  for (int j = 0; j < 8; ++j) {
-    for (int i = 0; i < 8; ++i) {
-      const std::int64_t px = std::int64_t(x) * kSubpixelOne + 16 + 32 * i;
-      const std::int64_t py = std::int64_t(y) * kSubpixelOne + 16 + 32 * j;
-      bool inside = true;
-      for (const auto& e : edges.e) inside = inside && e.at(px, py) >= 0;
-      if (inside) mask |= std::uint64_t(1) << (j * 8 + i);
+/// The mask of the samples (i, j) for which `inside(i, j)` holds: bit j * 16 + i.
+template <class Inside>
+SampleMask grid_mask(Inside inside) {
+  SampleMask mask = SampleMask::none();
+  for (int j = 0; j < kMaskGridSide; ++j) {
+    for (int i = 0; i < kMaskGridSide; ++i) {
+      const int s = j * kMaskGridSide + i;
+      if (inside(i, j)) mask.word[s / 64] |= std::uint64_t(1) << (s % 64);
     }
   }
   return mask;
 }
 
-/// Edges whose 64 samples in pixel (x, y) are neither all inside nor all outside.
+/// The mask from the edge functions evaluated at every sample directly (no stepping).
+SampleMask direct_mask(const TriangleSetup& t, int x, int y) {
+  const TriangleEdges edges(t);
+  return grid_mask([&](int i, int j) {
+    const std::int64_t px = std::int64_t(sample_fx8(x, i)), py = std::int64_t(sample_fx8(y, j));
+    bool inside = true;
+    for (const auto& e : edges.e) inside = inside && e.at(px, py) >= 0;
+    return inside;
+  });
+}
+
+/// Edges whose 256 samples in pixel (x, y) are neither all inside nor all outside.
 int crossing_edges(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
   int crossing = 0;
   for (const auto& e : edges.e) {
-    int inside = 0;
-    for (int s = 0; s < 64; ++s) {
-      inside += e.at(std::int64_t(x) * kSubpixelOne + 16 + 32 * (s & 7),
-                     std::int64_t(y) * kSubpixelOne + 16 + 32 * (s >> 3)) >= 0;
-    }
-    crossing += inside > 0 && inside < 64;
+    const int inside = grid_mask([&](int i, int j) {
+                         return e.at(sample_fx8(x, i), sample_fx8(y, j)) >= 0;
+                       }).count();
+    crossing += inside > 0 && inside < kMaskSamples;
   }
   return crossing;
 }
 
-std::string hex(std::uint64_t v) {
-  char buf[24];
-  std::snprintf(buf, sizeof(buf), "0x%016llx", static_cast<unsigned long long>(v));
+/// The mask as 64 hex digits, sample 255 first.
+std::string hex(const SampleMask& m) {
+  char buf[80];
+  std::snprintf(
+      buf, sizeof(buf), "0x%016llx%016llx%016llx%016llx",
+      static_cast<unsigned long long>(m.word[3]), static_cast<unsigned long long>(m.word[2]),
+      static_cast<unsigned long long>(m.word[1]), static_cast<unsigned long long>(m.word[0]));
   return buf;
 }
 
@@ -110,85 +123,112 @@ void for_each_implementation(const std::function<void(const std::string&, MaskFn
 }
 
 TEST_CASE("sample mask: hand-computed masks and top-left ties", "[coverage]") {
-  // Sample k of a pixel lies at (2k + 1) / 16 along each axis: 1/16, 3/16, ..., 15/16.
-  constexpr std::uint64_t kLeftColumns = 0x0F0F0F0F0F0F0F0Full;   // i = 0..3 in every row
-  constexpr std::uint64_t kRightColumns = 0xF0F0F0F0F0F0F0F0ull;  // i = 4..7
-  constexpr std::uint64_t kTopRows = 0x00000000FFFFFFFFull;       // j = 0..3
-  constexpr std::uint64_t kBottomRows = 0xFFFFFFFF00000000ull;    // j = 4..7
-  constexpr std::int32_t kBig = 32 * kSubpixelOne;                // 32 px
+  // Sample k of a pixel lies at (2k + 1) / 32 along each axis: 1/32, 3/32, ..., 31/32.
+  const SampleMask left_columns = grid_mask([](int i, int) { return i < 8; });
+  const SampleMask right_columns = grid_mask([](int i, int) { return i >= 8; });
+  const SampleMask top_rows = grid_mask([](int, int j) { return j < 8; });
+  const SampleMask bottom_rows = grid_mask([](int, int j) { return j >= 8; });
+  // The grid's layout, spelled out: columns 0..7 are the low byte of every 16-bit row.
+  for (std::uint64_t w : left_columns.word) REQUIRE(w == 0x00FF00FF00FF00FFull);
+  for (int j = 0; j < kMaskGridSide; ++j) {
+    REQUIRE(left_columns.row(j) == 0x00FFu);
+    REQUIRE(bottom_rows.row(j) == (j >= 8 ? 0xFFFFu : 0u));
+  }
+  // Rows 0..7 are words 0 and 1.
+  REQUIRE(top_rows.word[0] == ~0ull);
+  REQUIRE(top_rows.word[1] == ~0ull);
+  REQUIRE(top_rows.word[2] == 0);
+  REQUIRE(top_rows.word[3] == 0);
+  constexpr std::int32_t kBig = 32 * kSubpixelOne;  // 32 px
 
   for_each_implementation([&](const std::string& name, MaskFn mask) {
     INFO(name);
     {
       // Left half of pixel (10, 20), its right edge on the line x = 10.5 (vertical, A -> B
-      // goes down: a right edge, bias -1). x = 0.5 = 8/16 lies between sample columns 3
-      // (7/16) and 4 (9/16): no sample is on the line, the top-left rule has nothing to
-      // decide, and exactly columns 0..3 are inside in all 8 rows.
+      // goes down: a right edge, bias -1). x = 0.5 = 16/32 lies between sample columns 7
+      // (15/32) and 8 (17/32): no sample is on the line, the top-left rule has nothing to
+      // decide, and exactly columns 0..7 are inside in all 16 rows.
       const std::int32_t line = 10 * kSubpixelOne + kSubpixelOne / 2;
       const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
       const TriangleSetup left =
           make_triangle(line, mid - kBig / 2, line, mid + kBig / 2, line - kBig, mid);
-      CHECK(hex(mask(left, 10, 20)) == hex(kLeftColumns));
-      CHECK(mask(left, 9, 20) == ~std::uint64_t(0));  // the whole pixel to the left
-      CHECK(mask(left, 11, 20) == 0);                 // the pixel to the right
+      CHECK(hex(mask(left, 10, 20)) == hex(left_columns));
+      CHECK(mask(left, 9, 20) == SampleMask::all());    // the whole pixel to the left
+      CHECK(mask(left, 11, 20) == SampleMask::none());  // the pixel to the right
     }
     {
-      // The line moved to x = 10 + 9/16, through sample column 4. The triangle on the left
-      // has it as a right edge (A -> B downwards, dy > 0: bias -1): the samples on the line
-      // are not its own, it keeps columns 0..3. The triangle on the right shares the edge
-      // as B -> A (upwards, dy < 0: a left edge, bias 0) and owns column 4: columns 4..7.
-      // Each sample exactly once: disjoint, and together the whole pixel.
-      const std::int32_t line = sample_fx8(10, 4);
+      // The line moved to x = 10 + 17/32, through sample column 8 (between two columns of
+      // an 8x8 grid). The triangle on the left has it as a right edge (A -> B downwards,
+      // dy > 0: bias -1): the samples on the line are not its own, it keeps columns 0..7.
+      // The triangle on the right shares the edge as B -> A (upwards, dy < 0: a left edge,
+      // bias 0) and owns column 8: columns 8..15. Each sample exactly once: disjoint, and
+      // together the whole pixel.
+      const std::int32_t line = sample_fx8(10, 8);
       const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
       const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
       const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
       const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
-      CHECK(hex(mask(left, 10, 20)) == hex(kLeftColumns));
-      CHECK(hex(mask(right, 10, 20)) == hex(kRightColumns));
+      CHECK(hex(mask(left, 10, 20)) == hex(left_columns));
+      CHECK(hex(mask(right, 10, 20)) == hex(right_columns));
     }
     {
-      // A horizontal edge through sample row 4 (y = 20 + 9/16). Below it, the edge runs
+      // The same with the line through the last column (x = 10 + 31/32): the left triangle
+      // keeps columns 0..14, the right one owns column 15 alone.
+      const std::int32_t line = sample_fx8(10, 15);
+      const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
+      const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
+      const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
+      const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
+      CHECK(hex(mask(left, 10, 20)) == hex(grid_mask([](int i, int) { return i < 15; })));
+      CHECK(hex(mask(right, 10, 20)) == hex(grid_mask([](int i, int) { return i == 15; })));
+    }
+    {
+      // A horizontal edge through sample row 8 (y = 20 + 17/32). Below it, the edge runs
       // A -> B to the right (dy == 0, dx > 0: a top edge, bias 0): the triangle below owns
-      // row 4, rows 4..7. Above, the same edge runs B -> A to the left (not a top edge):
-      // rows 0..3 only.
-      const std::int32_t line = sample_fx8(20, 4);
+      // row 8, rows 8..15. Above, the same edge runs B -> A to the left (not a top edge):
+      // rows 0..7 only.
+      const std::int32_t line = sample_fx8(20, 8);
       const std::int32_t mid = 10 * kSubpixelOne + kSubpixelOne / 2;
       const TriangleSetup below =
           make_triangle(mid - kBig, line, mid + kBig, line, mid, line + kBig);
       const TriangleSetup above =
           make_triangle(mid + kBig, line, mid - kBig, line, mid, line - kBig);
-      CHECK(hex(mask(below, 10, 20)) == hex(kBottomRows));
-      CHECK(hex(mask(above, 10, 20)) == hex(kTopRows));
+      CHECK(hex(mask(below, 10, 20)) == hex(bottom_rows));
+      CHECK(hex(mask(above, 10, 20)) == hex(top_rows));
     }
     {
-      // A triangle 6 x 5 fx8 units around sample (i, j) = (2, 5) of pixel (-3, 7), far
-      // smaller than the 32-unit sample spacing: that one sample, bit 5 * 8 + 2 = 42.
-      const std::int32_t sx = sample_fx8(-3, 2), sy = sample_fx8(7, 5);
+      // A triangle 6 x 5 fx8 units around sample (i, j) = (13, 11) of pixel (-3, 7), far
+      // smaller than the 16-unit sample spacing: that one sample, bit 11 * 16 + 13 = 189
+      // (bit 61 of word 2).
+      const std::int32_t sx = sample_fx8(-3, 13), sy = sample_fx8(7, 11);
       const TriangleSetup tiny = make_triangle(sx - 3, sy - 2, sx + 3, sy - 2, sx, sy + 3);
-      CHECK(hex(mask(tiny, -3, 7)) == hex(std::uint64_t(1) << 42));
-      CHECK(mask(tiny, -2, 7) == 0);
-      // The same shape around the pixel centre (8/16, 8/16) lies between samples: no bit.
+      SampleMask one = SampleMask::none();
+      one.word[2] = std::uint64_t(1) << 61;
+      CHECK(hex(mask(tiny, -3, 7)) == hex(one));
+      CHECK(mask(tiny, -2, 7) == SampleMask::none());
+      // The same shape around the pixel centre (16/32, 16/32) lies between samples: no bit.
       const std::int32_t cx = -3 * kSubpixelOne + 128, cy = 7 * kSubpixelOne + 128;
       const TriangleSetup between = make_triangle(cx - 3, cy - 2, cx + 3, cy - 2, cx, cy + 3);
-      CHECK(mask(between, -3, 7) == 0);
+      CHECK(mask(between, -3, 7) == SampleMask::none());
     }
     {
-      // The square [4/16, 12/16]^2 of pixel (5, -2) holds samples i, j = 2..5 (its sides lie
-      // between sample lines): rows 2..5, byte 0x3C each. Split along its diagonal from
-      // (4/16, 4/16) to (12/16, 12/16), which passes through samples (2, 2), (3, 3), (4, 4),
-      // (5, 5). Upper-right triangle (y < x) P0 -> P1 -> P2: the diagonal is P2 -> P0, going
-      // up (dy < 0): a left edge, so it owns the diagonal: rows 2..5 = 0x3C, 0x38, 0x30,
-      // 0x20 (i >= j). Lower-left P0 -> P2 -> P3: the diagonal goes down (dy > 0), not
-      // top-left: rows 3..5 = 0x04, 0x0C, 0x1C (i < j).
+      // The square [8/32, 24/32]^2 of pixel (5, -2) holds samples i, j = 4..11 (its sides
+      // lie between sample lines). Split along its diagonal from (8/32, 8/32) to
+      // (24/32, 24/32), which passes through the samples (k, k), k = 4..11. Upper-right
+      // triangle (y < x) P0 -> P1 -> P2: the diagonal is P2 -> P0, going up (dy < 0): a left
+      // edge, so it owns the diagonal: i >= j. Lower-left P0 -> P2 -> P3: the diagonal goes
+      // down (dy > 0), not top-left: i < j.
       const std::int32_t x0 = 5 * kSubpixelOne + 64, x1 = 5 * kSubpixelOne + 192;
       const std::int32_t y0 = -2 * kSubpixelOne + 64, y1 = -2 * kSubpixelOne + 192;
       const TriangleSetup upper_right = make_triangle(x0, y0, x1, y0, x1, y1);
       const TriangleSetup lower_left = make_triangle(x0, y0, x1, y1, x0, y1);
-      const std::uint64_t ur = mask(upper_right, 5, -2), ll = mask(lower_left, 5, -2);
-      CHECK(hex(ur) == hex(0x00002030383C0000ull));
-      CHECK(hex(ll) == hex(0x00001C0C04000000ull));
-      CHECK((ur & ll) == 0);
-      CHECK(hex(ur | ll) == hex(0x00003C3C3C3C0000ull));
+      auto in_square = [](int i, int j) { return i >= 4 && i <= 11 && j >= 4 && j <= 11; };
+      const SampleMask ur = mask(upper_right, 5, -2), ll = mask(lower_left, 5, -2);
+      CHECK(hex(ur) == hex(grid_mask([&](int i, int j) { return in_square(i, j) && i >= j; })));
+      CHECK(hex(ll) == hex(grid_mask([&](int i, int j) { return in_square(i, j) && i < j; })));
+      CHECK((ur & ll) == SampleMask::none());
+      CHECK(hex(ur | ll) == hex(grid_mask(in_square)));
+      CHECK((ur | ll).count() == 64);
     }
   });
 }
@@ -212,7 +252,7 @@ class CaseGenerator {
       case 0:
         return std::int32_t(pixel * kSubpixelOne);
       case 1:
-        return std::int32_t(pixel * kSubpixelOne + 16 + 32 * uniform(0, 7));
+        return std::int32_t(pixel * kSubpixelOne + 8 + 16 * uniform(0, kMaskGridSide - 1));
       case 2:
         return std::int32_t(pixel * kSubpixelOne + 128);
       default:
@@ -250,7 +290,7 @@ class CaseGenerator {
         const std::int64_t x = snap(cx), y = snap(cy);
         std::int64_t w = uniform(-r, r), h = uniform(-r, r);
         if (uniform(0, 1) == 0) {  // on the sample or pixel lattice
-          const std::int64_t unit = uniform(0, 1) == 0 ? 32 : kSubpixelOne;
+          const std::int64_t unit = uniform(0, 1) == 0 ? 16 : kSubpixelOne;
           w = w / unit * unit;
           h = h / unit * unit;
         }
@@ -334,7 +374,7 @@ TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[covera
 
   // The reference against a direct evaluation at each sample, and what the cases exercise:
   // how many edges cross the sample grid (the SIMD lanes run only for crossing edges).
-  std::vector<std::uint64_t> reference(cases.size());
+  std::vector<SampleMask> reference(cases.size());
   std::size_t direct_mismatch = 0, partial = 0, full = 0, empty = 0;
   std::size_t by_crossing[4] = {};
   std::string first_direct;
@@ -346,9 +386,9 @@ TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[covera
     }
     if (c >= wide_begin) continue;
     ++by_crossing[crossing_edges(k.t, k.x, k.y)];
-    if (reference[c] == 0) {
+    if (reference[c] == SampleMask::none()) {
       ++empty;
-    } else if (reference[c] == ~std::uint64_t(0)) {
+    } else if (reference[c] == SampleMask::all()) {
       ++full;
     } else {
       ++partial;
@@ -376,7 +416,7 @@ TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[covera
     std::string first;
     for (std::size_t c = 0; c < cases.size(); ++c) {
       const Case& k = cases[c];
-      const std::uint64_t got = mask(k.t, k.x, k.y);
+      const SampleMask got = mask(k.t, k.x, k.y);
       if (got != reference[c] && mismatch++ == 0) {
         first = describe(k.t, k.x, k.y) + ": " + hex(got) + ", scalar " + hex(reference[c]);
       }

@@ -8,6 +8,7 @@
 #include "resolve/srgb8.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <bit>
 #include <cstddef>
@@ -371,7 +372,7 @@ bool ABufferTile::add_covering_tile(const TriangleSetup& t, const PixelRect& r) 
   return order != 0;
 }
 
-void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, std::uint64_t mask,
+void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask,
                              glm::vec3 color, int x, int y) {
   Fragment& fragment = pool_[f];
   if (!(fragment.coverage & kMergedFlag)) {
@@ -621,58 +622,98 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   return glm::vec3(float(r), float(g), float(b));
 }
 
+namespace {
+
+/// Offsets of the sample rows and columns from sample (0, 0) [pixels]: k / 16, exact.
+constexpr auto kSampleOffset = [] {
+  std::array<double, kMaskGridSide> offset{};
+  for (int k = 0; k < kMaskGridSide; ++k) offset[std::size_t(k)] = double(k) / kMaskGridSide;
+  return offset;
+}();
+
+/// A triangle's plane at the samples of one pixel: z(i, j) = row(j) + dz/dx * i / 16,
+/// row(j) = z00 + dz/dy * j / 16, z00 its depth at sample (0, 0). Every comparison of
+/// sample_weights uses these expressions (no contraction: -ffp-contract=off), so its results
+/// do not depend on where or how often they are evaluated.
+struct SamplePlane {
+  double z00, dzdx, dzdy;
+  SamplePlane(const TriangleSetup& t, int x, int y)
+      : z00(t.depth_at(x + 0.5 / kMaskGridSide, y + 0.5 / kMaskGridSide)),
+        dzdx(t.dzdx),
+        dzdy(t.dzdy) {}
+  double row(int j) const { return z00 + dzdy * kSampleOffset[std::size_t(j)]; }
+  double at(double row_z, int i) const { return row_z + dzdx * kSampleOffset[std::size_t(i)]; }
+};
+
+}  // namespace
+
 /// Visibility per sub-pixel sample, with per-sample depth from each plane: a fragment's
 /// weight is its coverage times the share of its samples where it is the nearest (equal
 /// depth keeps the earlier triangle). Only the samples a fragment owns are evaluated.
 void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n,
                                  const TriangleSetup* const* tri, const std::uint32_t* cov,
                                  const MergedPiece* const* merged, double* weight) const {
-  constexpr int kSamples = 64;
-  double best_z[kSamples];
-  std::uint32_t best_primitive[kSamples];
-  std::int8_t best[kSamples];
-  for (int s = 0; s < kSamples; ++s) {
-    const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
-    best_z[s] =
-        opaque != nullptr ? opaque->depth_at(sx, sy) : std::numeric_limits<double>::infinity();
-    best_primitive[s] = opaque != nullptr ? opaque->primitive : kNoTriangle;
-    best[s] = -1;
+  double best_z[kMaskSamples];
+  std::uint32_t best_primitive[kMaskSamples];
+  // Per sample, the fragment nearest so far plus one (0: none); won[k + 1] counts the
+  // samples fragment k holds, kept as samples change hands (won[0] only takes the
+  // decrements of samples that no fragment held before).
+  std::uint8_t best[kMaskSamples];
+  int won[kMaxFragmentsPerPixel + 1] = {};
+  static_assert(kMaxFragmentsPerPixel < 256);
+  if (opaque != nullptr) {
+    const SamplePlane plane(*opaque, x, y);
+    for (int j = 0; j < kMaskGridSide; ++j) {
+      const double row_z = plane.row(j);
+      for (int i = 0; i < kMaskGridSide; ++i) best_z[j * kMaskGridSide + i] = plane.at(row_z, i);
+    }
+  } else {
+    std::fill(best_z, best_z + kMaskSamples, std::numeric_limits<double>::infinity());
   }
-  std::uint64_t mask[kMaxFragmentsPerPixel];
+  std::fill(best_primitive, best_primitive + kMaskSamples,
+            opaque != nullptr ? opaque->primitive : kNoTriangle);
+  std::memset(best, 0, sizeof(best));
+  SampleMask mask[kMaxFragmentsPerPixel];
   for (int i = 0; i < n; ++i) {
     mask[i] = merged[i] != nullptr ? merged[i]->mask : pixel_sample_mask(*tri[i], x, y);
     const std::uint32_t primitive = tri[i]->primitive;
-    for (std::uint64_t bits = mask[i]; bits != 0; bits &= bits - 1) {
-      const int s = std::countr_zero(bits);
-      const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
-      const double z = tri[i]->depth_at(sx, sy);
-      // Nearest wins; equal depth keeps the earlier triangle. The (depth, primitive) order
-      // is total, so the winner does not depend on the order fragments are visited in.
-      if (z < best_z[s] || (z == best_z[s] && primitive < best_primitive[s])) {
-        best_z[s] = z;
-        best_primitive[s] = primitive;
-        best[s] = std::int8_t(i);
+    const SamplePlane plane(*tri[i], x, y);
+    for (int j = 0; j < kMaskGridSide; ++j) {
+      std::uint32_t bits = mask[i].row(j);
+      if (bits == 0) continue;
+      const double row_z = plane.row(j);
+      for (; bits != 0; bits &= bits - 1) {
+        const int k = std::countr_zero(bits), s = j * kMaskGridSide + k;
+        const double z = plane.at(row_z, k);
+        // Nearest wins; equal depth keeps the earlier triangle. The (depth, primitive) order
+        // is total, so the winner does not depend on the order fragments are visited in.
+        if (z < best_z[s] || (z == best_z[s] && primitive < best_primitive[s])) {
+          best_z[s] = z;
+          best_primitive[s] = primitive;
+          --won[best[s]];
+          ++won[i + 1];
+          best[s] = std::uint8_t(i + 1);
+        }
       }
     }
   }
-  int won[kMaxFragmentsPerPixel] = {};
-  for (int s = 0; s < kSamples; ++s) {
-    if (best[s] >= 0) ++won[best[s]];
-  }
   for (int i = 0; i < n; ++i) {
-    const int samples = std::popcount(mask[i]);
+    const int samples = mask[i].count();
     double share;
     if (samples > 0) {
-      share = double(won[i]) / samples;
+      share = double(won[i + 1]) / samples;
     } else {
       // Too small to own a sample: spread it over the pixel, and count the samples where
       // its plane would be nearer than what won them.
+      const SamplePlane plane(*tri[i], x, y);
       int nearer = 0;
-      for (int s = 0; s < kSamples; ++s) {
-        const double sx = x + ((s & 7) + 0.5) / 8.0, sy = y + ((s >> 3) + 0.5) / 8.0;
-        nearer += tri[i]->depth_at(sx, sy) < best_z[s];
+      for (int j = 0; j < kMaskGridSide; ++j) {
+        const double row_z = plane.row(j);
+        for (int k = 0; k < kMaskGridSide; ++k) {
+          nearer += plane.at(row_z, k) < best_z[j * kMaskGridSide + k];
+        }
       }
-      share = nearer / double(kSamples);
+      share = nearer / double(kMaskSamples);
     }
     weight[i] = double(cov[i]) / kCoverageOne * share;
   }

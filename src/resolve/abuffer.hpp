@@ -14,7 +14,7 @@
 //    behind; adjacent triangles of a tessellation add to exactly one pixel, so no background
 //    leaks through seams. A pixel whose fragments form one layer as they arrive keeps these
 //    sums as it goes and resolves from them, without walking its list;
-//  - otherwise, per 8x8 sub-pixel samples from the same fixed-point edge functions, with
+//  - otherwise, per 16x16 sub-pixel samples from the same fixed-point edge functions, with
 //    per-sample depth from each triangle's plane: a fragment's weight is its coverage times
 //    the share of its samples where it is the nearest; what remains goes to the opaque
 //    surface behind, or the background.
@@ -24,6 +24,7 @@
 #include "raster/coverage_kernel.hpp"
 #include "raster/shading.hpp"
 #include "raster/tile_raster.hpp"
+#include "resolve/sample_mask.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -117,7 +118,7 @@ class ABufferTile {
   };
   /// What a fragment that stands for several triangles of one surface keeps (overflow only).
   struct MergedPiece {
-    std::uint64_t mask;    ///< 8x8 sample mask: the union of the pieces'
+    SampleMask mask;       ///< 16x16 sample mask: the union of the pieces'
     glm::vec3 color;       ///< coverage-weighted mean colour (linear)
     std::uint32_t weight;  ///< summed coverage behind `color` (unclamped)
   };
@@ -150,7 +151,7 @@ class ABufferTile {
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
   /// Merges a piece (coverage, sample mask, colour at the pixel centre) into fragment `f`.
-  void merge_into(std::uint32_t f, std::uint32_t coverage, std::uint64_t mask, glm::vec3 color,
+  void merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask, glm::vec3 color,
                   int x, int y);
   /// The merged data of fragment `f` (which has kMergedFlag).
   const MergedPiece& merged_piece(std::uint32_t f) const { return merged_[merged_slot_[f]]; }
