@@ -10,7 +10,9 @@
 //                                          ssaa:16; <impl> scalar or simd:<target>)
 //   kernel/sample_raster/<mode>/<impl>/<size>  RasterTriangleFn, the whole per-triangle loop
 //   kernel/sample_resolve/<mode>/<impl>    ResolvePixelsFn, the box-filter sums of a band
-//   stage/transform, stage/setup_chunk, stage/bin_chunk   on sphere_grid at 1920x1080
+//   stage/transform, stage/setup_chunk, stage/bin_chunk   on sphere_grid at 1920x1080, each
+//                                          as the pipeline calls it (setup_chunk into a
+//                                          SetupVector plus pixel bounds, bin_chunk from those)
 //
 // The coverage kernel runs on realistic inputs: random triangles inside a 64 x 64 tile, set
 // up group by group of kColumnGroup columns exactly as the coverage rasterizer does, and the
@@ -695,7 +697,8 @@ void run_sample_resolve(benchmark::State& state, const SampleMode& mode, std::in
 struct GridStages {
   covrast::Scene scene;
   std::unique_ptr<GeometryFrontEnd> front_end;
-  std::vector<std::vector<TriangleSetup>> chunks;
+  std::vector<SetupVector> chunks;
+  std::vector<std::vector<PixelBounds16>> bounds;  ///< per chunk, for binning
 };
 
 GridStages& grid_stages() {
@@ -712,9 +715,10 @@ GridStages& grid_stages() {
       stages.front_end->transform_vertices(i, 0, stages.front_end->vertex_count(i));
     }
     stages.chunks.resize(stages.front_end->chunk_count());
+    stages.bounds.resize(stages.front_end->chunk_count());
     SetupCounters counters;
     for (std::uint32_t c = 0; c < stages.front_end->chunk_count(); ++c) {
-      stages.front_end->setup_chunk(c, stages.chunks[c], counters);
+      stages.front_end->setup_chunk(c, stages.chunks[c], stages.bounds[c], counters);
     }
   }
   return stages;
@@ -839,7 +843,9 @@ void register_all() {
                                    SetupCounters counters;
                                    for (std::uint32_t c = 0; c < s.front_end->chunk_count(); ++c) {
                                      s.chunks[c].clear();
-                                     s.front_end->setup_chunk(c, s.chunks[c], counters);
+                                     s.bounds[c].clear();
+                                     s.front_end->setup_chunk(c, s.chunks[c], s.bounds[c],
+                                                              counters);
                                    }
                                    benchmark::DoNotOptimize(counters);
                                  });
@@ -852,9 +858,9 @@ void register_all() {
                                  static std::vector<std::uint32_t> scratch;
                                  run_stage(state, [](GridStages& s) {
                                    const TileGrid grid(s.scene.width, s.scene.height, 64);
-                                   bins.resize(s.chunks.size());
-                                   for (std::size_t c = 0; c < s.chunks.size(); ++c)
-                                     bin_chunk(grid, s.chunks[c], bins[c], scratch);
+                                   bins.resize(s.bounds.size());
+                                   for (std::size_t c = 0; c < s.bounds.size(); ++c)
+                                     bin_chunk(grid, s.bounds[c], bins[c], scratch);
                                    benchmark::DoNotOptimize(bins.data());
                                  });
                                })

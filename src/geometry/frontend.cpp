@@ -7,6 +7,10 @@
 #include <array>
 #include <cmath>
 
+#if defined(__x86_64__) || defined(_M_X64)
+#include <emmintrin.h>
+#endif
+
 namespace covrast::detail {
 namespace {
 
@@ -24,11 +28,36 @@ using ClipPlane = glm::dvec4;
 /// Outcode bits of the near and far planes (planes_[0] and planes_[1]).
 constexpr unsigned kNearFarBits = 1u << 0 | 1u << 1;
 
-/// A model-space position in clip space. The one expression for it: transform_vertices and
+/// Two doubles in one SSE2 / NEON register (GCC and Clang vector extension); arithmetic on
+/// it is lane-wise IEEE arithmetic, the same results as on each lane alone.
+using Double2 = double __attribute__((vector_size(16)));
+
+/// Row r of mvp * (x, y, z, 1): the one expression for a model-space position in clip space.
+/// transform_vertices (two vertices at a time, T = Double2, or one, T = double) and
 /// clip_triangle both use it, so (with -ffp-contract=off) a vertex gets the same clip
-/// position, bit for bit, whichever computes it.
+/// position, bit for bit, whichever computes it. The order is glm's for mat4 * vec4,
+/// (m0 x + m1 y) + (m2 z + m3 * 1), with m3 * 1 = m3.
+template <class T>
+inline T clip_row(const glm::dmat4& mvp, int r, T x, T y, T z) {
+  return (mvp[0][r] * x + mvp[1][r] * y) + (mvp[2][r] * z + mvp[3][r]);
+}
+
 inline glm::dvec4 clip_position(const glm::dmat4& mvp, const glm::vec3& position) {
-  return mvp * glm::dvec4(glm::dvec3(position), 1.0);
+  const double x = position.x, y = position.y, z = position.z;
+  return glm::dvec4(clip_row(mvp, 0, x, y, z), clip_row(mvp, 1, x, y, z), clip_row(mvp, 2, x, y, z),
+                    clip_row(mvp, 3, x, y, z));
+}
+
+/// std::llrint(v) in the current rounding mode. glibc's x86-64 llrint is the single
+/// instruction cvtsd2si (round to nearest even; 0x8000000000000000 for NaN and overflow),
+/// but without -fno-math-errno the compiler keeps it an out-of-line call: issued here
+/// directly it is the same instruction, inlined. Elsewhere the library call.
+inline std::int64_t round_to_int64(double v) {
+#if defined(__x86_64__) || defined(_M_X64)
+  return _mm_cvtsd_si64(_mm_set_sd(v));
+#else
+  return std::llrint(v);
+#endif
 }
 
 }  // namespace
@@ -143,14 +172,29 @@ inline unsigned GeometryFrontEnd::outcode(const glm::dvec4& clip) const {
   return code;
 }
 
+// outcode() for the planes the constructor sets, without their zero terms. glm::dot sums
+// (a.x b.x + a.y b.y) + (a.z b.z + a.w b.w); a zero coefficient times a finite coordinate
+// is +-0, and adding +-0 changes a sum at most in the sign of a zero result, which `< 0`
+// does not see. So for finite coordinates each test below is the plane's dot product test,
+// e.g. left: (x + 0 y) + (0 z + g_x w) < 0  <=>  x + g_x w < 0. A non-finite coordinate
+// (0 * inf = NaN) takes the general loop.
+inline unsigned GeometryFrontEnd::fast_outcode(const glm::dvec4& c) const {
+  // x - x is 0 for finite x and NaN otherwise.
+  if (!((c.x - c.x) + (c.y - c.y) + (c.z - c.z) + (c.w - c.w) == 0.0)) return outcode(c);
+  const double gxw = guard_x_ * c.w, gyw = guard_y_ * c.w;
+  return unsigned(c.z + c.w < 0.0) | unsigned(-c.z + c.w < 0.0) << 1 |
+         unsigned(c.x + gxw < 0.0) << 2 | unsigned(-c.x + gxw < 0.0) << 3 |
+         unsigned(c.y + gyw < 0.0) << 4 | unsigned(-c.y + gyw < 0.0) << 5;
+}
+
 // Inline, so that transform_vertices writes the snapped vertex in place (a returned copy
 // costs a store-forwarding stall per vertex).
 inline SnappedVertex GeometryFrontEnd::snap(const glm::dvec4& c) const {
   const double inv_w = 1.0 / c.w;
   const double x_px = (c.x * inv_w + 1.0) * 0.5 * width_px_;
   const double y_px = (1.0 - c.y * inv_w) * 0.5 * height_px_;
-  return SnappedVertex{std::int32_t(std::llrint(x_px * kSubpixelOne)),
-                       std::int32_t(std::llrint(y_px * kSubpixelOne)),
+  return SnappedVertex{std::int32_t(round_to_int64(x_px * kSubpixelOne)),
+                       std::int32_t(round_to_int64(y_px * kSubpixelOne)),
                        std::clamp(c.z * inv_w * 0.5 + 0.5, 0.0, 1.0), float(inv_w)};
 }
 
@@ -159,18 +203,56 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
   const MeshInstance& inst = scene_.meshes[instance];
   const glm::dmat4 mvp = view_projection_ * inst.model;
   InstanceVertices& out = vertices_[instance];
+  const std::vector<glm::vec3>& positions = inst.mesh->positions;
+  const double width = width_px_, height = height_px_;
   // Block by block, each block's outcode union into its own slot.
   for (std::size_t block_begin = begin; block_begin < end;) {
     const std::size_t block = block_begin / kVerticesPerTransformBlock;
     const std::size_t block_end = std::min(end, (block + 1) * kVerticesPerTransformBlock);
     unsigned codes = 0;
-    for (std::size_t v = block_begin; v < block_end; ++v) {
-      const glm::dvec4 clip = clip_position(mvp, inst.mesh->positions[v]);
-      const auto code = std::uint8_t(outcode(clip));
+    const auto one_vertex = [&](std::size_t v) {
+      const glm::dvec4 clip = clip_position(mvp, positions[v]);
+      const auto code = std::uint8_t(fast_outcode(clip));
       out.outcode[v] = code;
       codes |= code;
       if (code == 0) out.snapped[v] = snap(clip);
+    };
+    std::size_t v = block_begin;
+    // Two vertices per step, lane k the scalar path's operations on vertex v + k (the
+    // fast_outcode tests and snap's arithmetic, in the same order).
+    for (; v + 2 <= block_end; v += 2) {
+      const glm::vec3& p0 = positions[v];
+      const glm::vec3& p1 = positions[v + 1];
+      const Double2 x = {p0.x, p1.x}, y = {p0.y, p1.y}, z = {p0.z, p1.z};
+      const Double2 cx = clip_row(mvp, 0, x, y, z), cy = clip_row(mvp, 1, x, y, z);
+      const Double2 cz = clip_row(mvp, 2, x, y, z), cw = clip_row(mvp, 3, x, y, z);
+      const Double2 finite = (cx - cx) + (cy - cy) + (cz - cz) + (cw - cw);
+      if (!(finite[0] == 0.0 && finite[1] == 0.0)) {
+        one_vertex(v);
+        one_vertex(v + 1);
+        continue;
+      }
+      const Double2 gxw = guard_x_ * cw, gyw = guard_y_ * cw;
+      // Comparisons give lanes of 0 or -1 (all bits set).
+      const auto code2 = ((cz + cw < 0.0) & 1) | ((-cz + cw < 0.0) & 2) | ((cx + gxw < 0.0) & 4) |
+                         ((-cx + gxw < 0.0) & 8) | ((cy + gyw < 0.0) & 16) |
+                         ((-cy + gyw < 0.0) & 32);
+      const Double2 inv_w = 1.0 / cw;
+      const Double2 x_fx8 = (cx * inv_w + 1.0) * 0.5 * width * double(kSubpixelOne);
+      const Double2 y_fx8 = (1.0 - cy * inv_w) * 0.5 * height * double(kSubpixelOne);
+      const Double2 z_window = cz * inv_w * 0.5 + 0.5;
+      for (int k = 0; k < 2; ++k) {
+        const auto code = std::uint8_t(code2[k]);
+        out.outcode[v + k] = code;
+        codes |= code;
+        if (code == 0) {
+          out.snapped[v + k] = SnappedVertex{std::int32_t(round_to_int64(x_fx8[k])),
+                                             std::int32_t(round_to_int64(y_fx8[k])),
+                                             std::clamp(z_window[k], 0.0, 1.0), float(inv_w[k])};
+        }
+      }
     }
+    if (v < block_end) one_vertex(v);
     out.block_outcodes[block] = std::uint8_t(codes);
     block_begin = block_end;
   }
@@ -218,46 +300,55 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const bool uniform_flat = uniform == uniform;
     for (; g < run_end; ++g, indices += 3) {
       const auto primitive = std::uint32_t(g);
-      glm::vec3 color[3];
+      // The triangle's vertex colours, by reference: no copies for the common uniform case.
+      glm::vec3 triangle_color;
+      const glm::vec3* c0;
+      const glm::vec3* c1;
+      const glm::vec3* c2;
       bool flat;
       switch (inst.color_source) {
         case ColorSource::Uniform:
-          color[0] = color[1] = color[2] = uniform;
+          c0 = c1 = c2 = &uniform;
           flat = uniform_flat;
           break;
         case ColorSource::PerTriangle: {
           const glm::vec3 c = per_triangle_color_srgb(primitive);
-          color[0] = color[1] = color[2] =
-              glm::vec3(srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b));
-          flat = color[0] == color[0];
+          triangle_color = glm::vec3(srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b));
+          c0 = c1 = c2 = &triangle_color;
+          flat = triangle_color == triangle_color;
           break;
         }
         case ColorSource::Vertex:
         default:
-          for (int k = 0; k < 3; ++k) color[k] = iv.color_linear[indices[k]];
-          flat = color[0] == color[1] && color[0] == color[2];
+          c0 = &iv.color_linear[indices[0]];
+          c1 = &iv.color_linear[indices[1]];
+          c2 = &iv.color_linear[indices[2]];
+          flat = *c0 == *c1 && *c0 == *c2;
           break;
       }
       // Outcodes: trivially reject when all three are outside one plane; trivially accept
       // (with the vertices snapped once in transform_vertices) when none is outside any.
-      const unsigned c0 = iv.outcode[indices[0]], c1 = iv.outcode[indices[1]],
-                     c2 = iv.outcode[indices[2]];
-      if ((c0 & c1 & c2) != 0) {
+      const unsigned o0 = iv.outcode[indices[0]], o1 = iv.outcode[indices[1]],
+                     o2 = iv.outcode[indices[2]];
+      if ((o0 & o1 & o2) != 0) {
         ++sink.counters.culled;
-      } else if ((c0 | c1 | c2) == 0) {
-        emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]], color,
-                      flat, primitive, std::uint32_t(instance), sink);
+      } else if ((o0 | o1 | o2) == 0) {
+        emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]], *c0,
+                      *c1, *c2, flat, primitive, std::uint32_t(instance), sink);
       } else {
-        clip_triangle(instance, mvp, indices, color, flat, c0 | c1 | c2, primitive, sink);
+        const glm::vec3 color[3] = {*c0, *c1, *c2};
+        clip_triangle(instance, mvp, indices, color, flat, o0 | o1 | o2, primitive, sink);
       }
     }
   }
 }
 
-void GeometryFrontEnd::emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1,
-                                     const SnappedVertex& v2, const glm::vec3* color, bool flat,
-                                     std::uint32_t primitive, std::uint32_t surface,
-                                     Sink& sink) const {
+// Inlined into setup_range's loop: as a call it spilled its arguments and the caller's
+// state on every triangle.
+[[gnu::always_inline]] inline void GeometryFrontEnd::emit_triangle(
+    const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+    const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2, bool flat,
+    std::uint32_t primitive, std::uint32_t surface, Sink& sink) const {
   const std::int64_t ax = v1.x_fx8 - v0.x_fx8, ay = v1.y_fx8 - v0.y_fx8;
   const std::int64_t bx = v2.x_fx8 - v0.x_fx8, by = v2.y_fx8 - v0.y_fx8;
   const std::int64_t area2 = ax * by - bx * ay;
@@ -322,9 +413,9 @@ void GeometryFrontEnd::emit_triangle(const SnappedVertex& v0, const SnappedVerte
   t.inv_w[0] = s0.inv_w;
   t.inv_w[1] = s1.inv_w;
   t.inv_w[2] = s2.inv_w;
-  t.color[0] = color[0];
-  t.color[1] = color[front ? 2 : 1];
-  t.color[2] = color[front ? 1 : 2];
+  t.color[0] = color0;
+  t.color[1] = front ? color2 : color1;
+  t.color[2] = front ? color1 : color2;
   t.primitive = primitive;
   t.surface = surface;
   t.front_facing = front;
@@ -377,8 +468,8 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
   }
   // Fan (0, k, k+1) over the clipped polygon.
   for (int k = 1; k + 1 < count; ++k) {
-    const glm::vec3 tc[3] = {pc[0], pc[k], pc[k + 1]};
-    emit_triangle(s[0], s[k], s[k + 1], tc, flat, primitive, std::uint32_t(instance), sink);
+    emit_triangle(s[0], s[k], s[k + 1], pc[0], pc[k], pc[k + 1], flat, primitive,
+                  std::uint32_t(instance), sink);
   }
 }
 

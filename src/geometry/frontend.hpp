@@ -101,6 +101,10 @@ class GeometryFrontEnd {
   /// covers whole transform blocks (see kVerticesPerTransformBlock).
   void transform_vertices(std::size_t instance, std::size_t begin, std::size_t end);
   std::size_t vertex_count(std::size_t instance) const;
+  /// The last transform_vertices results of one instance (for tests).
+  const InstanceVertices& instance_vertices(std::size_t instance) const {
+    return vertices_[instance];
+  }
 
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order.
   void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
@@ -113,6 +117,8 @@ class GeometryFrontEnd {
  private:
   SnappedVertex snap(const glm::dvec4& clip) const;
   unsigned outcode(const glm::dvec4& clip) const;
+  /// outcode(clip), bit for bit, for the planes_ the constructor sets.
+  unsigned fast_outcode(const glm::dvec4& clip) const;
   /// Where emitted triangles go: `bounds` may be null.
   struct Sink {
     std::vector<TriangleSetup>* out;  ///< exactly one of out and setups is set
@@ -128,8 +134,8 @@ class GeometryFrontEnd {
     }
   };
   void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
-                     const glm::vec3* color, bool flat, std::uint32_t primitive,
-                     std::uint32_t surface, Sink& sink) const;
+                     const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2,
+                     bool flat, std::uint32_t primitive, std::uint32_t surface, Sink& sink) const;
   /// `mvp`: view_projection_ times the instance's model matrix, as in transform_vertices.
   void clip_triangle(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
                      const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,
