@@ -136,6 +136,50 @@ TEST_CASE("front end: vertices, outcodes and set-ups match the glm reference bit
   for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) fe.setup_chunk(c, setups, bounds, counters);
   REQUIRE(bounds.size() == setups.size());
 
+  // The pipeline's ChunkSetups give the same triangles and bounds, both within a slice of one
+  // per input triangle and when a 1-triangle slice forces the move to an own array.
+  auto same_setup = [](const TriangleSetup& a, const TriangleSetup& b) {
+    bool same = same_bits(a.z0, b.z0) && same_bits(a.dzdx, b.dzdx) && same_bits(a.dzdy, b.dzdy) &&
+                a.primitive == b.primitive && a.surface == b.surface &&
+                a.front_facing == b.front_facing && a.flat_color == b.flat_color;
+    for (int k = 0; k < 3; ++k) {
+      same = same && a.x_fx8[k] == b.x_fx8[k] && a.y_fx8[k] == b.y_fx8[k] &&
+             same_bits(a.inv_w[k], b.inv_w[k]) && std::memcmp(&a.color[k], &b.color[k], 12) == 0;
+    }
+    return same;
+  };
+  for (std::size_t slice_triangles :
+       {std::size_t(covrast::detail::kTrianglesPerChunk), std::size_t(1)}) {
+    covrast::detail::HugePageBuffer storage(fe.chunk_count() * slice_triangles *
+                                            sizeof(TriangleSetup));
+    std::size_t k = 0, mismatches = 0, overflowed = 0, expect_overflowed = 0;
+    for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) {
+      TriangleSetup* slice = static_cast<TriangleSetup*>(storage.data()) + c * slice_triangles;
+      covrast::detail::ChunkSetups chunk;
+      const std::size_t capacity =
+          std::min<std::size_t>(slice_triangles, fe.chunk_triangle_count(c));
+      chunk.reset(slice, capacity);
+      std::vector<PixelBounds16> chunk_bounds;
+      SetupCounters chunk_counters;
+      fe.setup_chunk(c, chunk, chunk_bounds, chunk_counters);
+      REQUIRE(chunk_bounds.size() == chunk.size());
+      if (chunk.data() != slice) ++overflowed;
+      if (chunk.size() > capacity) ++expect_overflowed;
+      for (std::size_t j = 0; j < chunk.size(); ++j, ++k) {
+        REQUIRE(k < setups.size());
+        if (!same_setup(chunk[j], setups[k]) ||
+            std::memcmp(&chunk_bounds[j], &bounds[k], sizeof(PixelBounds16)) != 0) {
+          ++mismatches;
+        }
+      }
+    }
+    CHECK(k == setups.size());
+    CHECK(mismatches == 0);
+    // Moved to an own array exactly when the slice ran full; 1-triangle slices must do so.
+    CHECK(overflowed == expect_overflowed);
+    if (slice_triangles == 1) CHECK(overflowed > 0);
+  }
+
   std::multimap<std::uint32_t, std::size_t> by_primitive;
   for (std::size_t k = 0; k < setups.size(); ++k) by_primitive.emplace(setups[k].primitive, k);
 

@@ -7,6 +7,10 @@
 #include <array>
 #include <cmath>
 
+#ifdef __linux__
+#include <sys/mman.h>
+#endif
+
 #if defined(__x86_64__) || defined(_M_X64)
 #include <emmintrin.h>
 #endif
@@ -267,15 +271,59 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
                                    SetupCounters& counters) const {
-  Sink sink{&out, nullptr, nullptr, counters};
+  Sink sink{&out, nullptr, nullptr, nullptr, counters};
   setup_range(chunk, sink);
 }
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, SetupVector& out,
                                    std::vector<PixelBounds16>& bounds,
                                    SetupCounters& counters) const {
-  Sink sink{nullptr, &out, &bounds, counters};
+  Sink sink{nullptr, &out, nullptr, &bounds, counters};
   setup_range(chunk, sink);
+}
+
+void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, ChunkSetups& out,
+                                   std::vector<PixelBounds16>& bounds,
+                                   SetupCounters& counters) const {
+  Sink sink{nullptr, nullptr, &out, &bounds, counters};
+  setup_range(chunk, sink);
+}
+
+void advise_huge_pages([[maybe_unused]] void* data, [[maybe_unused]] std::size_t bytes) {
+#if defined(__linux__) && defined(MADV_HUGEPAGE)
+  // The whole huge pages inside the range: [round_up(begin), round_down(end)).
+  const std::uintptr_t begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + kHugePageBytes - 1) & ~(kHugePageBytes - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePageBytes - 1);
+  // The result is ignored: without huge pages the memory simply stays in 4 KiB pages.
+  if (data != nullptr && first < last) {
+    (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+  }
+#endif
+}
+
+HugePageBuffer::HugePageBuffer(std::size_t bytes)
+    // Whole huge pages, so that the last one is advised too.
+    : bytes_((std::max<std::size_t>(bytes, 1) + kHugePageBytes - 1) & ~(kHugePageBytes - 1)) {
+  data_ = ::operator new(bytes_, std::align_val_t(kHugePageBytes));
+  advise_huge_pages(data_, bytes_);
+}
+
+HugePageBuffer::~HugePageBuffer() {
+  if (data_ != nullptr) ::operator delete(data_, std::align_val_t(kHugePageBytes));
+}
+
+TriangleSetup& ChunkSetups::grow() {
+  // Twice the room, default-initialised (every field is written by setup), the triangles so
+  // far copied over; further growth stays in the own array.
+  const std::size_t capacity = std::max<std::size_t>(2 * capacity_, 64);
+  std::unique_ptr<TriangleSetup[]> bigger =
+      std::make_unique_for_overwrite<TriangleSetup[]>(capacity);
+  std::copy(data_, data_ + size_, bigger.get());
+  overflow_ = std::move(bigger);
+  data_ = overflow_.get();
+  capacity_ = capacity;
+  return data_[size_++];
 }
 
 void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {

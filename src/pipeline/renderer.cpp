@@ -101,7 +101,11 @@ struct Renderer::Impl {
   int threads;
   detail::TileGrid grid;
   detail::GeometryFrontEnd front_end;
-  std::vector<detail::SetupVector> chunk_triangles;
+  /// Every chunk's set-up triangles, chunk c in its slice from triangle c * kTrianglesPerChunk:
+  /// one allocation, so that a first frame faults it in as a few huge pages rather than
+  /// ~7000 small ones (one frame per process is the usual command-line use).
+  detail::HugePageBuffer setup_storage;
+  std::vector<detail::ChunkSetups> chunk_triangles;
   std::vector<std::vector<detail::PixelBounds16>> chunk_bounds;  ///< per triangle, for binning
   std::vector<detail::ChunkBins> chunk_bins;
   tbb::task_arena arena;
@@ -118,6 +122,7 @@ struct Renderer::Impl {
         threads(t),
         grid(w, h, o.tile),
         front_end(s, w, h, o.cull_hidden_backfaces),
+        setup_storage(front_end.triangle_count() * sizeof(TriangleSetup)),
         arena(t),
         rasterizers(
             [mode = o.mode, tile = o.tile] { return detail::make_tile_rasterizer(mode, tile); }) {
@@ -183,10 +188,11 @@ RenderResult Renderer::render_frame() {
     });
     // Setup, part 2: clip, snap and set up each chunk of triangles.
     tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
-      // Room for one output per input (clipping can add more): the first frame then
-      // fills each buffer without reallocating and copying it.
-      im.chunk_triangles[c].clear();
-      im.chunk_triangles[c].reserve(im.front_end.chunk_triangle_count(c));
+      // Room for one output per input in the chunk's slice (clipping can add more, and then
+      // the chunk moves to its own array).
+      im.chunk_triangles[c].reset(static_cast<TriangleSetup*>(im.setup_storage.data()) +
+                                      std::size_t(c) * detail::kTrianglesPerChunk,
+                                  im.front_end.chunk_triangle_count(c));
       im.chunk_bounds[c].clear();
       im.chunk_bounds[c].reserve(im.front_end.chunk_triangle_count(c));
       im.front_end.setup_chunk(c, im.chunk_triangles[c], im.chunk_bounds[c],
