@@ -11,8 +11,9 @@
 //   kernel/sample_raster/<mode>/<impl>/<size>  RasterTriangleFn, the whole per-triangle loop
 //   kernel/sample_resolve/<mode>/<impl>    ResolvePixelsFn, the box-filter sums of a band
 //   stage/transform, stage/setup_chunk, stage/bin_chunk   on sphere_grid at 1920x1080, each
-//                                          as the pipeline calls it (setup_chunk into a
-//                                          SetupVector plus pixel bounds, bin_chunk from those)
+//                                          as the pipeline calls it (setup_chunk into
+//                                          ChunkSetups slices of one huge-page buffer plus
+//                                          pixel bounds, bin_chunk from those)
 //
 // The coverage kernel runs on realistic inputs: random triangles inside a 64 x 64 tile, set
 // up group by group of kColumnGroup columns exactly as the coverage rasterizer does, and the
@@ -697,9 +698,22 @@ void run_sample_resolve(benchmark::State& state, const SampleMode& mode, std::in
 struct GridStages {
   covrast::Scene scene;
   std::unique_ptr<GeometryFrontEnd> front_end;
-  std::vector<SetupVector> chunks;
+  std::unique_ptr<HugePageBuffer> setup_storage;  ///< the chunks' slices, as the renderer's
+  std::vector<ChunkSetups> chunks;
   std::vector<std::vector<PixelBounds16>> bounds;  ///< per chunk, for binning
 };
+
+/// Sets up every chunk of `s` as Renderer::render_frame does: each chunk starts over in its
+/// slice of the shared buffer.
+void setup_all_chunks(GridStages& s, SetupCounters& counters) {
+  for (std::uint32_t c = 0; c < s.front_end->chunk_count(); ++c) {
+    s.chunks[c].reset(
+        static_cast<TriangleSetup*>(s.setup_storage->data()) + std::size_t(c) * kTrianglesPerChunk,
+        s.front_end->chunk_triangle_count(c));
+    s.bounds[c].clear();
+    s.front_end->setup_chunk(c, s.chunks[c], s.bounds[c], counters);
+  }
+}
 
 GridStages& grid_stages() {
   static GridStages stages = [] {
@@ -714,12 +728,12 @@ GridStages& grid_stages() {
     for (std::size_t i = 0; i < stages.front_end->instance_count(); ++i) {
       stages.front_end->transform_vertices(i, 0, stages.front_end->vertex_count(i));
     }
+    stages.setup_storage = std::make_unique<HugePageBuffer>(stages.front_end->triangle_count() *
+                                                            sizeof(TriangleSetup));
     stages.chunks.resize(stages.front_end->chunk_count());
     stages.bounds.resize(stages.front_end->chunk_count());
     SetupCounters counters;
-    for (std::uint32_t c = 0; c < stages.front_end->chunk_count(); ++c) {
-      stages.front_end->setup_chunk(c, stages.chunks[c], stages.bounds[c], counters);
-    }
+    setup_all_chunks(stages, counters);
   }
   return stages;
 }
@@ -841,12 +855,7 @@ void register_all() {
                                [](benchmark::State& state) {
                                  run_stage(state, [](GridStages& s) {
                                    SetupCounters counters;
-                                   for (std::uint32_t c = 0; c < s.front_end->chunk_count(); ++c) {
-                                     s.chunks[c].clear();
-                                     s.bounds[c].clear();
-                                     s.front_end->setup_chunk(c, s.chunks[c], s.bounds[c],
-                                                              counters);
-                                   }
+                                   setup_all_chunks(s, counters);
                                    benchmark::DoNotOptimize(counters);
                                  });
                                })

@@ -27,7 +27,6 @@ using covrast::Scene;
 using covrast::detail::GeometryFrontEnd;
 using covrast::detail::PixelBounds16;
 using covrast::detail::SetupCounters;
-using covrast::detail::SetupVector;
 using covrast::detail::TriangleSetup;
 
 struct RefVertex {
@@ -130,14 +129,20 @@ TEST_CASE("front end: vertices, outcodes and set-ups match the glm reference bit
           i, v, std::min(fe.vertex_count(i), v + covrast::detail::kVerticesPerTransformBlock));
     }
   }
-  SetupVector setups;
+  // Every chunk's triangles and bounds in order, each chunk set up without a slice (its own
+  // growing array from the start).
+  std::vector<TriangleSetup> setups;
   std::vector<PixelBounds16> bounds;
   SetupCounters counters;
-  for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) fe.setup_chunk(c, setups, bounds, counters);
+  for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) {
+    covrast::detail::ChunkSetups own;
+    fe.setup_chunk(c, own, bounds, counters);
+    setups.insert(setups.end(), own.data(), own.data() + own.size());
+  }
   REQUIRE(bounds.size() == setups.size());
 
-  // The pipeline's ChunkSetups give the same triangles and bounds, both within a slice of one
-  // per input triangle and when a 1-triangle slice forces the move to an own array.
+  // The pipeline's slices give the same triangles and bounds, both within a slice of one per
+  // input triangle and when a 1-triangle slice forces the move to an own array.
   auto same_setup = [](const TriangleSetup& a, const TriangleSetup& b) {
     bool same = same_bits(a.z0, b.z0) && same_bits(a.dzdx, b.dzdx) && same_bits(a.dzdy, b.dzdy) &&
                 a.primitive == b.primitive && a.surface == b.surface &&

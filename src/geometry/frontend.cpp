@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <new>
 
 #ifdef __linux__
 #include <sys/mman.h>
@@ -271,21 +272,14 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
                                    SetupCounters& counters) const {
-  Sink sink{&out, nullptr, nullptr, nullptr, counters};
-  setup_range(chunk, sink);
-}
-
-void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, SetupVector& out,
-                                   std::vector<PixelBounds16>& bounds,
-                                   SetupCounters& counters) const {
-  Sink sink{nullptr, &out, nullptr, &bounds, counters};
+  Sink sink{&out, nullptr, nullptr, counters};
   setup_range(chunk, sink);
 }
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, ChunkSetups& out,
                                    std::vector<PixelBounds16>& bounds,
                                    SetupCounters& counters) const {
-  Sink sink{nullptr, nullptr, &out, &bounds, counters};
+  Sink sink{nullptr, &out, &bounds, counters};
   setup_range(chunk, sink);
 }
 

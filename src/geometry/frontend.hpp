@@ -16,8 +16,6 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
-#include <new>
-#include <utility>
 #include <vector>
 
 namespace covrast::detail {
@@ -54,25 +52,6 @@ struct InstanceVertices {
   std::vector<std::uint8_t> block_outcodes;
 };
 
-/// An allocator whose value-less construct() default-initialises: a vector of it grows
-/// without zeroing the new elements first (setup writes every field of each triangle;
-/// zeroing 112 bytes per triangle was a visible share of setup time).
-template <class T>
-struct DefaultInitAllocator : std::allocator<T> {
-  using std::allocator<T>::allocator;
-  template <class U>
-  void construct(U* p) noexcept {
-    ::new (static_cast<void*>(p)) U;
-  }
-  template <class U, class... Args>
-  void construct(U* p, Args&&... args) {
-    ::new (static_cast<void*>(p)) U(std::forward<Args>(args)...);
-  }
-};
-
-/// One chunk's set-up triangles in a growing vector (tests, benchmarks).
-using SetupVector = std::vector<TriangleSetup, DefaultInitAllocator<TriangleSetup>>;
-
 /// Transparent huge page size on x86-64 and most arm64 kernels: the unit madvise works in.
 inline constexpr std::size_t kHugePageBytes = std::size_t(2) << 20;
 
@@ -101,6 +80,7 @@ class HugePageBuffer {
 /// One chunk's set-up triangles as the pipeline keeps them: written into the chunk's fixed
 /// slice of a frame-wide buffer (room for one triangle per input triangle, enough unless
 /// clipping splits triangles), and moved to an own, growing array if the slice runs full.
+/// Without a slice (reset(nullptr, 0), or as constructed) it is a plain growing array.
 class ChunkSetups {
  public:
   /// Starts over, writing to `slice` (room for `capacity` triangles).
@@ -160,11 +140,9 @@ class GeometryFrontEnd {
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order.
   void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
                    SetupCounters& counters) const;
-  /// The same, and appends each emitted triangle's touched pixels clamped to the image
-  /// to `bounds` (for binning).
-  void setup_chunk(std::uint32_t chunk, SetupVector& out, std::vector<PixelBounds16>& bounds,
-                   SetupCounters& counters) const;
-  /// The same into a ChunkSetups (the pipeline's form).
+  /// The same into a ChunkSetups (the pipeline's form, started over with reset() by the
+  /// caller), and appends each emitted triangle's touched pixels clamped to the image to
+  /// `bounds` (for binning).
   void setup_chunk(std::uint32_t chunk, ChunkSetups& out, std::vector<PixelBounds16>& bounds,
                    SetupCounters& counters) const;
 
@@ -175,8 +153,7 @@ class GeometryFrontEnd {
   unsigned fast_outcode(const glm::dvec4& clip) const;
   /// Where emitted triangles go: `bounds` may be null.
   struct Sink {
-    std::vector<TriangleSetup>* out;  ///< exactly one of out, setups and chunk is set
-    SetupVector* setups;
+    std::vector<TriangleSetup>* out;  ///< exactly one of out and chunk is set
     ChunkSetups* chunk;
     std::vector<PixelBounds16>* bounds;
     SetupCounters& counters;
@@ -184,10 +161,7 @@ class GeometryFrontEnd {
     /// kDropCounterClockwise or 0.
     unsigned drop_facing = 0;
     /// A new triangle at the end of the output, its fields to be written.
-    TriangleSetup& next() {
-      if (chunk != nullptr) return chunk->emplace_back();
-      return setups != nullptr ? setups->emplace_back() : out->emplace_back();
-    }
+    TriangleSetup& next() { return chunk != nullptr ? chunk->emplace_back() : out->emplace_back(); }
   };
   void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
                      const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2,
