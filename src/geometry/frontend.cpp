@@ -65,6 +65,50 @@ inline std::int64_t round_to_int64(double v) {
 #endif
 }
 
+/// 0 where x, y, z and w are all finite (x - x is 0 for finite x), NaN otherwise; lane by
+/// lane for T = Double2.
+template <class T>
+inline T finite_test(T x, T y, T z, T w) {
+  return (x - x) + (y - y) + (z - z) + (w - w);
+}
+
+/// Bit `bit` of an outcode where `outside` holds: a bool (T = double) or a lane mask of 0 or
+/// -1 (T = Double2).
+inline unsigned plane_bit(bool outside, int bit) { return unsigned(outside) << bit; }
+template <class Mask>
+inline Mask plane_bit(Mask outside, int bit) {
+  return outside & (1 << bit);
+}
+
+/// The outcode of clip position (x, y, z, w) for GeometryFrontEnd's planes, without their zero
+/// terms (valid for finite coordinates; see fast_outcode): near, far, left, right, bottom,
+/// top, with guard-band factors gx, gy.
+template <class T>
+inline auto outcode_bits(T x, T y, T z, T w, double gx, double gy) {
+  const T gxw = gx * w, gyw = gy * w;
+  return plane_bit(z + w < 0.0, 0) | plane_bit(-z + w < 0.0, 1) | plane_bit(x + gxw < 0.0, 2) |
+         plane_bit(-x + gxw < 0.0, 3) | plane_bit(y + gyw < 0.0, 4) | plane_bit(-y + gyw < 0.0, 5);
+}
+
+/// The viewport transform of a clip position, before rounding: x and y in 24.8 units, window
+/// z (not yet clamped) and 1 / w.
+template <class T>
+struct ScreenPosition {
+  T x_fx8, y_fx8, z_window, inv_w;
+};
+template <class T>
+inline ScreenPosition<T> to_screen(T x, T y, T z, T w, double width_px, double height_px) {
+  const T inv_w = 1.0 / w;
+  return ScreenPosition<T>{(x * inv_w + 1.0) * 0.5 * width_px * double(kSubpixelOne),
+                           (1.0 - y * inv_w) * 0.5 * height_px * double(kSubpixelOne),
+                           z * inv_w * 0.5 + 0.5, inv_w};
+}
+
+/// One screen position rounded to the snapped vertex.
+inline SnappedVertex snapped_vertex(double x_fx8, double y_fx8, double z_window, double inv_w) {
+  return SnappedVertex{std::int32_t(round_to_int64(x_fx8)), std::int32_t(round_to_int64(y_fx8)),
+                       std::clamp(z_window, 0.0, 1.0), float(inv_w)};
+}
 }  // namespace
 
 // Hidden back-face culling. The back faces of an instance are dropped when all of these hold:
@@ -184,23 +228,15 @@ inline unsigned GeometryFrontEnd::outcode(const glm::dvec4& clip) const {
 // e.g. left: (x + 0 y) + (0 z + g_x w) < 0  <=>  x + g_x w < 0. A non-finite coordinate
 // (0 * inf = NaN) takes the general loop.
 inline unsigned GeometryFrontEnd::fast_outcode(const glm::dvec4& c) const {
-  // x - x is 0 for finite x and NaN otherwise.
-  if (!((c.x - c.x) + (c.y - c.y) + (c.z - c.z) + (c.w - c.w) == 0.0)) return outcode(c);
-  const double gxw = guard_x_ * c.w, gyw = guard_y_ * c.w;
-  return unsigned(c.z + c.w < 0.0) | unsigned(-c.z + c.w < 0.0) << 1 |
-         unsigned(c.x + gxw < 0.0) << 2 | unsigned(-c.x + gxw < 0.0) << 3 |
-         unsigned(c.y + gyw < 0.0) << 4 | unsigned(-c.y + gyw < 0.0) << 5;
+  if (!(finite_test(c.x, c.y, c.z, c.w) == 0.0)) return outcode(c);
+  return outcode_bits(c.x, c.y, c.z, c.w, guard_x_, guard_y_);
 }
 
 // Inline, so that transform_vertices writes the snapped vertex in place (a returned copy
 // costs a store-forwarding stall per vertex).
 inline SnappedVertex GeometryFrontEnd::snap(const glm::dvec4& c) const {
-  const double inv_w = 1.0 / c.w;
-  const double x_px = (c.x * inv_w + 1.0) * 0.5 * width_px_;
-  const double y_px = (1.0 - c.y * inv_w) * 0.5 * height_px_;
-  return SnappedVertex{std::int32_t(round_to_int64(x_px * kSubpixelOne)),
-                       std::int32_t(round_to_int64(y_px * kSubpixelOne)),
-                       std::clamp(c.z * inv_w * 0.5 + 0.5, 0.0, 1.0), float(inv_w)};
+  const ScreenPosition<double> p = to_screen(c.x, c.y, c.z, c.w, width_px_, height_px_);
+  return snapped_vertex(p.x_fx8, p.y_fx8, p.z_window, p.inv_w);
 }
 
 void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begin,
@@ -223,37 +259,28 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
       if (code == 0) out.snapped[v] = snap(clip);
     };
     std::size_t v = block_begin;
-    // Two vertices per step, lane k the scalar path's operations on vertex v + k (the
-    // fast_outcode tests and snap's arithmetic, in the same order).
+    // Two vertices per step: lane k runs the one-vertex path's templates (finite_test,
+    // outcode_bits, to_screen, snapped_vertex) on vertex v + k.
     for (; v + 2 <= block_end; v += 2) {
       const glm::vec3& p0 = positions[v];
       const glm::vec3& p1 = positions[v + 1];
       const Double2 x = {p0.x, p1.x}, y = {p0.y, p1.y}, z = {p0.z, p1.z};
       const Double2 cx = clip_row(mvp, 0, x, y, z), cy = clip_row(mvp, 1, x, y, z);
       const Double2 cz = clip_row(mvp, 2, x, y, z), cw = clip_row(mvp, 3, x, y, z);
-      const Double2 finite = (cx - cx) + (cy - cy) + (cz - cz) + (cw - cw);
+      const Double2 finite = finite_test(cx, cy, cz, cw);
       if (!(finite[0] == 0.0 && finite[1] == 0.0)) {
         one_vertex(v);
         one_vertex(v + 1);
         continue;
       }
-      const Double2 gxw = guard_x_ * cw, gyw = guard_y_ * cw;
-      // Comparisons give lanes of 0 or -1 (all bits set).
-      const auto code2 = ((cz + cw < 0.0) & 1) | ((-cz + cw < 0.0) & 2) | ((cx + gxw < 0.0) & 4) |
-                         ((-cx + gxw < 0.0) & 8) | ((cy + gyw < 0.0) & 16) |
-                         ((-cy + gyw < 0.0) & 32);
-      const Double2 inv_w = 1.0 / cw;
-      const Double2 x_fx8 = (cx * inv_w + 1.0) * 0.5 * width * double(kSubpixelOne);
-      const Double2 y_fx8 = (1.0 - cy * inv_w) * 0.5 * height * double(kSubpixelOne);
-      const Double2 z_window = cz * inv_w * 0.5 + 0.5;
+      const auto code2 = outcode_bits(cx, cy, cz, cw, guard_x_, guard_y_);
+      const ScreenPosition<Double2> p = to_screen(cx, cy, cz, cw, width, height);
       for (int k = 0; k < 2; ++k) {
         const auto code = std::uint8_t(code2[k]);
         out.outcode[v + k] = code;
         codes |= code;
         if (code == 0) {
-          out.snapped[v + k] = SnappedVertex{std::int32_t(round_to_int64(x_fx8[k])),
-                                             std::int32_t(round_to_int64(y_fx8[k])),
-                                             std::clamp(z_window[k], 0.0, 1.0), float(inv_w[k])};
+          out.snapped[v + k] = snapped_vertex(p.x_fx8[k], p.y_fx8[k], p.z_window[k], p.inv_w[k]);
         }
       }
     }
