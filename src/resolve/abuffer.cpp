@@ -127,6 +127,38 @@ FrontLayer find_front_layer(int n, const DepthRange* range, const std::uint32_t*
   return layer;
 }
 
+/// The triangles each fragment of a pixel stands for: itself, or a merged fragment's
+/// pieces (count -1: not known).
+struct FragmentPieces {
+  const TriangleSetup* const* piece;
+  int count;
+};
+
+/// Whether two fragments' triangles have pairwise disjoint interiors (triangle_overlap.hpp).
+bool fragments_disjoint(FragmentPieces a, FragmentPieces b) {
+  if (a.count < 0 || b.count < 0) return false;
+  for (int i = 0; i < a.count; ++i) {
+    for (int j = 0; j < b.count; ++j) {
+      if (!interiors_disjoint(*a.piece[i], *b.piece[j])) return false;
+    }
+  }
+  return true;
+}
+
+/// Whether the fragments i with `member[i]` (all when null) provably do not overlap, so
+/// that their exact areas add.
+bool pieces_disjoint(int n, const FragmentPieces* pieces, const bool* member) {
+  for (int i = 0; i < n; ++i) {
+    if (member != nullptr && !member[i]) continue;
+    if (pieces[i].count < 0) return false;
+    for (int j = i + 1; j < n; ++j) {
+      if (member != nullptr && !member[j]) continue;
+      if (!fragments_disjoint(pieces[i], pieces[j])) return false;
+    }
+  }
+  return true;
+}
+
 /// A convex polygon in pixel coordinates: the pixel square clipped by up to four lines.
 struct ClipPolygon {
   double x[8], y[8];
@@ -211,6 +243,7 @@ DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, i
 
 namespace {
 std::atomic<bool> g_list_resolve{false};
+std::atomic<bool> g_mask_resolve{false};
 std::atomic<std::uint64_t> g_layer_resolves{0};
 std::atomic<int> g_capacity{kMaxFragmentsPerPixel};
 }  // namespace
@@ -221,6 +254,10 @@ void force_abuffer_capacity(int fragments) {
 }
 
 void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
+void force_abuffer_mask_resolve(bool on) {
+  g_mask_resolve.store(on);
+  g_list_resolve.store(on);
+}
 std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
 
 ABufferTile::ABufferTile(int tile_px)
@@ -239,6 +276,9 @@ ABufferTile::ABufferTile(int tile_px)
   count_.resize(n);
   layer_.resize(n);
   layer_sums_.resize(n);
+  open_count_.resize(n);
+  closed_count_.resize(n);
+  occluder_z_.resize(n);
   color_.resize(n);
   depth_.resize(n);
 }
@@ -318,6 +358,9 @@ void ABufferTile::materialize_block(std::size_t b) {
       head_[pixel] = kEnd;
       count_[pixel] = 0;
       layer_[pixel] = Layer::Empty;
+      open_count_[pixel] = 0;
+      closed_count_[pixel] = 0;
+      occluder_z_[pixel] = kFar;
     }
   }
 }
@@ -373,30 +416,73 @@ bool ABufferTile::add_covering_tile(const TriangleSetup& t, const PixelRect& r) 
 }
 
 void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask,
-                             glm::vec3 color, int x, int y) {
+                             glm::vec3 color, int x, int y, const TriangleSetup* const* pieces,
+                             int piece_count) {
   Fragment& fragment = pool_[f];
   if (!(fragment.coverage & kMergedFlag)) {
     if (merged_slot_.size() < pool_.size()) merged_slot_.resize(pool_.size(), kEnd);
     merged_slot_[f] = std::uint32_t(merged_.size());
-    merged_.push_back(MergedPiece{pixel_sample_mask(*fragment.triangle, x, y),
-                                  shade(*fragment.triangle, x + 0.5, y + 0.5, true),
-                                  fragment.coverage});
+    MergedPiece first{pixel_sample_mask(*fragment.triangle, x, y),
+                      shade(*fragment.triangle, x + 0.5, y + 0.5, true),
+                      fragment.coverage & kCoverageBits,
+                      1,
+                      {fragment.triangle}};
+    merged_.push_back(first);
   }
   MergedPiece& m = merged_[merged_slot_[f]];
   m.mask |= mask;
+  if (m.pieces != kUnknownPieces && piece_count >= 0 &&
+      m.pieces + piece_count <= kMaxMergedPieces) {
+    for (int k = 0; k < piece_count; ++k) m.piece[m.pieces++] = pieces[k];
+  } else {
+    m.pieces = kUnknownPieces;
+  }
   // Running coverage-weighted mean of the pieces' colours.
   const std::uint32_t weight = m.weight + coverage;
   if (weight > 0) {
     m.color = (m.color * float(m.weight) + color * float(coverage)) / float(weight);
   }
   m.weight = weight;
-  const std::uint32_t sum = (fragment.coverage & ~kMergedFlag) + coverage;
-  fragment.coverage = kMergedFlag | std::min<std::uint32_t>(sum, kCoverageOne);
+  const std::uint32_t sum = (fragment.coverage & kCoverageBits) + coverage;
+  fragment.coverage = (fragment.coverage & (kOpenFlag | kClosedFlag)) | kMergedFlag |
+                      std::min<std::uint32_t>(sum, kCoverageOne);
+}
+
+bool ABufferTile::merge_into_open_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                                      std::uint32_t coverage, double centre_z) {
+  // The member with the fewest pieces, preferring one that shares a vertex with t (a
+  // neighbour in the tessellation: the merged colour then mixes neighbours).
+  std::uint32_t into = kEnd;
+  int best = 2 * kMaxMergedPieces;
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kOpenFlag)) continue;
+    const TriangleSetup* const* pieces;
+    const int count = fragment_pieces(f, pieces);
+    if (count < 0 || count >= kMaxMergedPieces) continue;
+    const int rank = share_vertex(*pool_[f].triangle, t) ? count : count + kMaxMergedPieces;
+    if (rank < best) {
+      best = rank;
+      into = f;
+    }
+  }
+  if (into == kEnd) return false;
+  const TriangleSetup* piece = &t;
+  merge_into(into, coverage, pixel_sample_mask(t, x, y), shade(t, x + 0.5, y + 0.5, true), x, y,
+             &piece, 1);
+  add_to_sums(pixel, x, y, t, coverage, centre_z);
+  if (layer_sums_[pixel].coverage >= std::uint32_t(kCoverageOne)) complete_open_set(pixel, x, y);
+  return true;
 }
 
 bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                   std::uint32_t coverage) {
   ++overflows_;
+  // Steps 1 and 2 look for fragments to drop in O(n^2); what they find changes only as new
+  // pieces arrive, so a pixel that keeps overflowing retries them every kDropRetry-th time
+  // (its open_count_ counts the overflows: an overflowed pixel keeps no sets), and merges
+  // in O(n) in between.
+  constexpr int kDropRetry = 16;
+  const bool try_drops = open_count_[pixel]++ % kDropRetry == 0;
   std::uint32_t id[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
   std::uint32_t cov[kMaxFragmentsPerPixel];
@@ -405,25 +491,30 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next, ++n) {
     id[n] = f;
     range[n] = pixel_depth_range(*pool_[f].triangle, x, y);
-    cov[n] = pool_[f].coverage & ~kMergedFlag;
+    cov[n] = pool_[f].coverage & kCoverageBits;
     keep[n] = true;
   }
   auto tri = [&](int i) -> const TriangleSetup& { return *pool_[id[i]].triangle; };
   auto merged = [&](int i) { return (pool_[id[i]].coverage & kMergedFlag) != 0; };
   // 1. Drop fragments that the opaque surface hides everywhere.
-  if (const TriangleSetup* opaque = opaque_[pixel]; opaque != nullptr) {
+  if (const TriangleSetup* opaque = opaque_[pixel]; try_drops && opaque != nullptr) {
     for (int i = 0; i < n; ++i) keep[i] = order_of(tri(i), *opaque, x, y) != DepthOrder::Behind;
   }
   // 2. Drop fragments wholly behind a layer that fills the pixel: the nearest fragment's
   //    connected pieces of one surface (as in resolve_pixel), when their areas add to one.
   bool in_layer[kMaxFragmentsPerPixel];
-  const FrontLayer layer = find_front_layer(
-      n, range, cov, keep,
-      [&](int i, int j) {
-        return layer_neighbours(tri(i), merged(i), range[i], tri(j), merged(j), range[j]);
-      },
-      in_layer);
-  if (layer.members > 0 && layer.coverage >= std::uint32_t(kCoverageOne)) {
+  const FrontLayer layer = !try_drops ? FrontLayer{0, 0, 0.0}
+                                      : find_front_layer(
+                                            n, range, cov, keep,
+                                            [&](int i, int j) {
+                                              return layer_neighbours(tri(i), merged(i), range[i],
+                                                                      tri(j), merged(j), range[j]);
+                                            },
+                                            in_layer);
+  FragmentPieces pieces[kMaxFragmentsPerPixel];
+  for (int i = 0; i < n; ++i) pieces[i].count = fragment_pieces(id[i], pieces[i].piece);
+  if (layer.members > 0 && layer.coverage >= std::uint32_t(kCoverageOne) &&
+      pieces_disjoint(n, pieces, in_layer)) {
     for (int i = 0; i < n; ++i) {
       if (keep[i] && !in_layer[i] && range[i].min > layer.max_depth) keep[i] = false;
     }
@@ -465,7 +556,7 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   }
   if (into >= 0) {
     merge_into(id[into], coverage, pixel_sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true),
-               x, y);
+               x, y, &t, 1);
     return true;
   }
   // 4. Merge two fragments of one surface and facing already in the list, freeing a slot:
@@ -487,10 +578,12 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
     const Fragment victim = pool_[id[drop_j]];
     if (victim.coverage & kMergedFlag) {
       const MergedPiece piece = merged_piece(id[drop_j]);  // a copy: merge_into may grow merged_
-      merge_into(id[keep_i], piece.weight, piece.mask, piece.color, x, y);
+      merge_into(id[keep_i], piece.weight, piece.mask, piece.color, x, y, piece.piece,
+                 piece.pieces == kUnknownPieces ? -1 : piece.pieces);
     } else {
-      merge_into(id[keep_i], victim.coverage, pixel_sample_mask(*victim.triangle, x, y),
-                 shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y);
+      merge_into(id[keep_i], victim.coverage & kCoverageBits,
+                 pixel_sample_mask(*victim.triangle, x, y),
+                 shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y, &victim.triangle, 1);
     }
     // Unlink the victim.
     const std::uint32_t prev = drop_j > 0 ? id[drop_j - 1] : kEnd;
@@ -515,16 +608,101 @@ bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const Triangl
   return true;
 }
 
-bool ABufferTile::joins_list(std::size_t pixel, const TriangleSetup& t) const {
+template <class Drop>
+void ABufferTile::remove_fragments(std::size_t pixel, Drop drop) {
+  std::uint32_t last = kEnd;
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    if (share_vertex(t, *pool_[f].triangle)) return true;
+    if (drop(pool_[f])) {
+      if (last == kEnd) {
+        head_[pixel] = pool_[f].next;
+      } else {
+        pool_[last].next = pool_[f].next;
+      }
+      --count_[pixel];
+      continue;
+    }
+    last = f;
+  }
+  tail_[pixel] = last;
+}
+
+bool ABufferTile::hidden_by_closed_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                                       double centre_z) const {
+  if (centre_z - depth_reach(t) >= occluder_z_[pixel]) return true;
+  // The closed set covers the pixel, so every point of t's part of it lies in a member that
+  // t overlaps: t is hidden when it is behind (or level with, being later) each of those.
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kClosedFlag)) continue;
+    const TriangleSetup* const* pieces;
+    const int count = fragment_pieces(f, pieces);
+    if (count < 0) return false;
+    for (int k = 0; k < count; ++k) {
+      const TriangleSetup& m = *pieces[k];
+      if (!interiors_disjoint(t, m) && order_of(t, m, x, y) != DepthOrder::Behind) return false;
+    }
+  }
+  return true;
+}
+
+bool ABufferTile::hidden_by_container(std::size_t pixel, int x, int y,
+                                      const TriangleSetup& t) const {
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (pool_[f].coverage & kMergedFlag) continue;
+    const TriangleSetup& m = *pool_[f].triangle;
+    if (contains_triangle(m, t) && order_of(t, m, x, y) == DepthOrder::Behind) return true;
   }
   return false;
 }
 
+void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
+  occluder_z_[pixel] = std::min(occluder_z_[pixel], layer_sums_[pixel].far);
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    std::uint32_t& c = pool_[f].coverage;
+    c = (c & kOpenFlag) ? (c & ~kOpenFlag) | kClosedFlag : c & ~kClosedFlag;
+  }
+  closed_count_[pixel] = open_count_[pixel];
+  open_count_[pixel] = 0;
+  if (count_[pixel] == closed_count_[pixel]) {
+    layer_[pixel] = Layer::One;  // nothing else to hide; the sums are the closed set's
+    return;
+  }
+  remove_fragments(pixel, [&](const Fragment& f) {
+    if (f.coverage & kClosedFlag) return false;
+    return hidden_by_closed_set(pixel, x, y, *f.triangle, f.triangle->depth_at(x + 0.5, y + 0.5));
+  });
+  if (count_[pixel] == closed_count_[pixel]) {
+    layer_[pixel] = Layer::One;  // the sums are the closed set's
+    return;
+  }
+  // Fragments in front of the closed set in places: a new open set from them, in list order.
+  layer_[pixel] = Layer::Mixed;
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    Fragment& fragment = pool_[f];
+    if ((fragment.coverage & kClosedFlag) || !joins_open_set(pixel, *fragment.triangle)) continue;
+    const TriangleSetup& t = *fragment.triangle;
+    add_to_sums(pixel, x, y, t, fragment.coverage & kCoverageBits, t.depth_at(x + 0.5, y + 0.5));
+    fragment.coverage |= kOpenFlag;
+    ++open_count_[pixel];
+  }
+}
+
 bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                                    std::uint32_t coverage) {
-  layer_[pixel] = Layer::Mixed;  // merges and drops: only the list knows
+                                    std::uint32_t coverage, double centre_z) {
+  if (layer_[pixel] != Layer::Overflowed && open_count_[pixel] != 0 && joins_open_set(pixel, *t) &&
+      merge_into_open_set(pixel, x, y, *t, coverage, centre_z)) {
+    ++overflows_;
+    return true;
+  }
+  if (layer_[pixel] != Layer::Overflowed) {
+    // Merges and drops: only the list knows. The occluder depth stays valid (what covered
+    // the pixel still does).
+    layer_[pixel] = Layer::Overflowed;
+    open_count_[pixel] = 0;
+    closed_count_[pixel] = 0;
+    for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+      pool_[f].coverage &= kMergedFlag | kCoverageBits;
+    }
+  }
   return handle_overflow(pixel, x, y, t, coverage);
 }
 
@@ -541,6 +719,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   std::uint32_t cov[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
   const MergedPiece* merged[kMaxFragmentsPerPixel];  // null unless it stands for several
+  FragmentPieces pieces[kMaxFragmentsPerPixel];
   int n = 0;
   bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
@@ -556,38 +735,22 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     }
     tri[n] = t;
     const std::uint32_t c = pool_[f].coverage;
-    cov[n] = c & ~kMergedFlag;
+    cov[n] = c & kCoverageBits;
     merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
+    pieces[n].count = fragment_pieces(f, pieces[n].piece);
     range[n] = r;
     depth = std::min(depth, float(centre_z));
     ++n;
   }
   if (n == 0) return behind;
 
-  // The front layer: the fragment nearest at its nearest point and every fragment
-  // connected to it (same mesh instance and facing, through shared vertices; a merged
-  // fragment already stands for adjacent pieces of its surface). Its pieces do not
-  // overlap, so their exact areas add.
-  auto connected = [&](int i, int j) {
-    return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
-                            range[j]);
-  };
-  bool in_front[kMaxFragmentsPerPixel];
-  const FrontLayer front = find_front_layer(n, range, cov, nullptr, connected, in_front);
-  const int members = front.members;
-  const std::uint32_t front_coverage = front.coverage;
-  const double front_max = front.max_depth;
-  bool front_separate = !crossing;
-  for (int j = 0; j < n && front_separate; ++j) {
-    if (!in_front[j] && !(front_max < range[j].min)) front_separate = false;
-  }
-
-  if (front_separate && (members == n || front_coverage >= std::uint32_t(kCoverageOne))) {
-    // One surface in front of everything else in this pixel: its exact areas add, and when
-    // they fill the pixel nothing behind shows.
-    LayerSums sums{0, 0, {0.0, 0.0, 0.0}, depth, nullptr, nullptr};
+  const bool sums_allowed = !g_mask_resolve.load(std::memory_order_relaxed);
+  // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
+  // the open set's sums give; resolve() takes those directly where it can).
+  auto layer_color = [&](const bool* member) {
+    LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0};
     for (int i = 0; i < n; ++i) {
-      if (!in_front[i]) continue;
+      if (member != nullptr && !member[i]) continue;
       const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
       sums.coverage += cov[i];
       sums.rgb[0] += double(cov[i]) * c.r;
@@ -595,6 +758,30 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
       sums.rgb[2] += double(cov[i]) * c.b;
     }
     return front_layer_color(sums, behind);
+  };
+  if (sums_allowed && !crossing && pieces_disjoint(n, pieces, nullptr)) {
+    return layer_color(nullptr);
+  }
+
+  // The front layer: the fragment nearest at its nearest point and every fragment
+  // connected to it (same mesh instance and facing, through shared vertices; a merged
+  // fragment already stands for adjacent pieces of its surface). When its pieces provably
+  // do not overlap and it lies wholly in front of everything else, its exact areas add, and
+  // when they fill the pixel nothing behind shows.
+  auto connected = [&](int i, int j) {
+    return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
+                            range[j]);
+  };
+  bool in_front[kMaxFragmentsPerPixel];
+  const FrontLayer front = find_front_layer(n, range, cov, nullptr, connected, in_front);
+  bool front_separate = !crossing;
+  for (int j = 0; j < n && front_separate; ++j) {
+    if (!in_front[j] && !(front.max_depth < range[j].min)) front_separate = false;
+  }
+  if (sums_allowed && front_separate &&
+      (front.members == n || front.coverage >= std::uint32_t(kCoverageOne)) &&
+      pieces_disjoint(n, pieces, in_front)) {
+    return layer_color(in_front);
   }
   double weight[kMaxFragmentsPerPixel];
   // One triangle crossing the opaque plane inside the pixel (where two surfaces
@@ -697,10 +884,14 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
       }
     }
   }
+  bool exact[kMaxFragmentsPerPixel];
+  unhidden_fragments(x, y, opaque, n, tri, merged, exact);
   for (int i = 0; i < n; ++i) {
     const int samples = mask[i].count();
     double share;
-    if (samples > 0) {
+    if (exact[i]) {
+      share = 1.0;  // nothing in front of it overlaps it: its whole area shows
+    } else if (samples > 0) {
       share = double(won[i + 1]) / samples;
     } else {
       // Too small to own a sample: spread it over the pixel, and count the samples where
@@ -716,6 +907,39 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
       share = nearer / double(kMaskSamples);
     }
     weight[i] = double(cov[i]) / kCoverageOne * share;
+  }
+}
+
+namespace {
+
+/// Whether `far` is behind `near` all over pixel (x, y): farther or level at its four corners
+/// (the planes are affine), and not the same plane drawn earlier (equal depth keeps the
+/// earlier triangle, as the samples do).
+bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near, int x, int y) {
+  const CornerDepths f = corner_depths(far, x, y), n = corner_depths(near, x, y);
+  int level = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (f.z[k] < n.z[k]) return false;
+    level += f.z[k] == n.z[k];
+  }
+  return level < 4 || near.primitive < far.primitive;
+}
+
+}  // namespace
+
+void ABufferTile::unhidden_fragments(int x, int y, const TriangleSetup* opaque, int n,
+                                     const TriangleSetup* const* tri,
+                                     const MergedPiece* const* merged, bool* exact) {
+  constexpr int kMaxPairs = 32;  // beyond it, n^2 tests cost more than they can save
+  for (int i = 0; i < n; ++i) {
+    bool alone = n <= kMaxPairs && merged[i] == nullptr &&
+                 (opaque == nullptr || behind_all_over(*opaque, *tri[i], x, y));
+    for (int j = 0; j < n && alone; ++j) {
+      if (j == i) continue;
+      alone = (merged[j] == nullptr && interiors_disjoint(*tri[i], *tri[j])) ||
+              behind_all_over(*tri[j], *tri[i], x, y);
+    }
+    exact[i] = alone;
   }
 }
 
@@ -736,8 +960,8 @@ void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelR
       if (target.depth == nullptr) continue;
       float* depth = &target.depth->depth[std::size_t(y) * target.depth->width + r.x0];
       for (int x = r.x0; x < r.x1; ++x) {
-        *depth++ =
-            opaque != nullptr ? std::min(float(opaque->depth_at(x + 0.5, y + 0.5)), 1.0f) : 1.0f;
+        *depth++ = opaque != nullptr ? clamp_window_depth(float(opaque->depth_at(x + 0.5, y + 0.5)))
+                                     : 1.0f;
       }
     }
     return;
@@ -774,7 +998,7 @@ void ABufferTile::resolve(const FrameTarget& target) {
         for (int x = br.x0; x < br.x1; ++x) {
           const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
           if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
-            // One layer over the background: what resolve_pixel's front-layer branch gives.
+            // One layer over the background: what resolve_pixel's first branch gives.
             const LayerSums& sums = layer_sums_[pixel];
             color_[pixel] = front_layer_color(sums, target.background_linear);
             depth_[pixel] = sums.depth;

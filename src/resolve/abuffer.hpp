@@ -7,17 +7,28 @@
 // runs once per tile, and once per 8x8 block, while the tile or block still shows a single
 // opaque triangle and the new one covers it completely; per-pixel state is written only
 // when a block needs it. Partly covered pixels keep a short list of fragments (triangle,
-// 8.8 coverage), resolved front to back when the tile is done:
-//  - one layer (fragments of one mesh instance and facing, connected through shared
-//    vertices) in front of everything else, alone or filling the pixel:
+// 8.8 coverage), resolved front to back when the tile is done.
+//
+// Exact areas add only where fragments provably do not overlap (triangle_overlap.hpp: a
+// separating edge, exact in integers). Each pixel grows an *open set* of fragments in
+// arrival order: a fragment joins it when it overlaps none of its members. So
+//  - while every fragment of a pixel is in the open set (Layer::One), the pixel keeps the
+//    set's running sums and, over the background, resolves from them alone:
 //    colour = sum(coverage_i * colour_i) / max(sum coverage, 1) + (1 - sum coverage) *
-//    behind; adjacent triangles of a tessellation add to exactly one pixel, so no background
-//    leaks through seams. A pixel whose fragments form one layer as they arrive keeps these
-//    sums as it goes and resolves from them, without walking its list;
-//  - otherwise, per 16x16 sub-pixel samples from the same fixed-point edge functions, with
-//    per-sample depth from each triangle's plane: a fragment's weight is its coverage times
-//    the share of its samples where it is the nearest; what remains goes to the opaque
-//    surface behind, or the background.
+//    background, exactly what the per-sample resolve gives for disjoint fragments;
+//  - when the open set's areas add up to the whole pixel, the pixel is covered by it
+//    (disjoint pieces whose areas fill the square leave at most the rounding of the 8.8
+//    values uncovered). It becomes the pixel's *closed set*: a later fragment that is farther
+//    than, or as far as, every member it overlaps (planes compared at the pixel corners) is
+//    hidden everywhere and never stored, and the fragments already stored that it hides
+//    leave the list. This is what keeps lists short on dense and open meshes, where no
+//    single triangle covers a pixel; the farthest depth of the set bounds it cheaply first;
+//  - otherwise the pixel resolves from its list (resolve_pixel): a set of pairwise disjoint
+//    fragments in front of the opaque surface adds its areas; else 16x16 sub-pixel samples
+//    with per-sample depth from each plane decide what hides what: a fragment that nothing
+//    in front of it overlaps keeps its exact area, the others get their coverage times the
+//    share of their samples where they are nearest; what remains goes to the opaque surface
+//    behind, or the background.
 #pragma once
 
 #include "geometry/triangle_setup.hpp"
@@ -25,6 +36,7 @@
 #include "raster/shading.hpp"
 #include "raster/tile_raster.hpp"
 #include "resolve/sample_mask.hpp"
+#include "resolve/triangle_overlap.hpp"
 
 #include <cmath>
 #include <cstddef>
@@ -47,6 +59,12 @@ inline constexpr int kMaxFragmentsPerPixel = 128;
 
 /// Block side [pixels] of the A-buffer's block-level fast path.
 inline constexpr int kAbufferBlockPx = 8;
+
+/// How far a triangle's plane can move from its pixel-centre depth within the pixel:
+/// (|dz/dx| + |dz/dy|) / 2.
+inline double depth_reach(const TriangleSetup& t) {
+  return 0.5 * (std::fabs(t.dzdx) + std::fabs(t.dzdy));
+}
 
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
@@ -73,6 +91,10 @@ inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
 /// Tests: resolve every pixel from its fragment list, never from the one-layer sums (the
 /// two must give the same bytes).
 void force_abuffer_list_resolve(bool on);
+/// Tests: resolve every pixel with fragments by its sub-pixel samples, never by adding areas
+/// (neither the sums nor the disjoint-set branches of resolve_pixel): the reference that the
+/// exact-area paths must match within rounding.
+void force_abuffer_mask_resolve(bool on);
 /// Tests: A-buffers made from now on keep at most `fragments` per pixel (0: back to
 /// kMaxFragmentsPerPixel), so that the overflow policy can be exercised on small scenes.
 void force_abuffer_capacity(int fragments);
@@ -114,15 +136,37 @@ class ABufferTile {
   struct Fragment {
     const TriangleSetup* triangle;  ///< when merged: the piece whose plane stands for all
     std::uint32_t next;             ///< index into pool_, or kEnd
-    std::uint32_t coverage;         ///< 8.8, 1/255 units; kMergedFlag: see merged_
+    /// 8.8, 1/255 units (kCoverageBits); kMergedFlag: see merged_; kOpenFlag, kClosedFlag:
+    /// member of the pixel's open or closed set.
+    std::uint32_t coverage;
   };
   /// What a fragment that stands for several triangles of one surface keeps (overflow only).
+  static constexpr int kMaxMergedPieces = 6;
+  static constexpr std::uint8_t kUnknownPieces = 0xff;
   struct MergedPiece {
     SampleMask mask;       ///< 16x16 sample mask: the union of the pieces'
     glm::vec3 color;       ///< coverage-weighted mean colour (linear)
     std::uint32_t weight;  ///< summed coverage behind `color` (unclamped)
+    /// The triangles it stands for, so that overlap tests stay exact (kUnknownPieces: more
+    /// than kMaxMergedPieces; such a fragment proves nothing).
+    std::uint8_t pieces;
+    const TriangleSetup* piece[kMaxMergedPieces];
   };
+  /// The triangles fragment `f` stands for, in `out`: one, a merged fragment's pieces, or
+  /// -1 when they are not known.
+  int fragment_pieces(std::uint32_t f, const TriangleSetup* const*& out) const {
+    if (!(pool_[f].coverage & kMergedFlag)) {
+      out = &pool_[f].triangle;
+      return 1;
+    }
+    const MergedPiece& m = merged_piece(f);
+    out = m.piece;
+    return m.pieces == kUnknownPieces ? -1 : m.pieces;
+  }
   static constexpr std::uint32_t kMergedFlag = 0x80000000u;
+  static constexpr std::uint32_t kOpenFlag = 0x40000000u;
+  static constexpr std::uint32_t kClosedFlag = 0x20000000u;
+  static constexpr std::uint32_t kCoverageBits = 0x1fffffffu;
   static constexpr std::uint32_t kEnd = 0xffffffffu;
 
   inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
@@ -141,23 +185,46 @@ class ABufferTile {
                            std::uint32_t coverage, double centre_z);
   /// The list is full: the overflow policy (handle_overflow); true when `t` was absorbed.
   bool overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                         std::uint32_t coverage);
-  /// Keeps the running sums of a pixel whose fragments so far form one layer (see LayerSums).
-  inline void track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                         std::uint32_t coverage, double centre_z);
+  /// Whether `t` overlaps no fragment of the pixel's open set (an empty set takes anything).
+  inline bool joins_open_set(std::size_t pixel, const TriangleSetup& t) const;
+  /// Adds fragment `t` to the open set's running sums (restarting them for an empty set).
+  inline void add_to_sums(std::size_t pixel, int x, int y, const TriangleSetup& t,
                           std::uint32_t coverage, double centre_z);
-  /// Whether `t` shares a vertex with any fragment in the pixel's list.
-  bool joins_list(std::size_t pixel, const TriangleSetup& t) const;
+  /// The open set's areas fill the pixel: it becomes the closed set (the pixel's occluder),
+  /// the fragments it hides leave the list, and a new open set is started from the rest.
+  void complete_open_set(std::size_t pixel, int x, int y);
+  /// Whether the pixel's closed set hides `t` everywhere in the pixel (see closed sets).
+  bool hidden_by_closed_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                            double centre_z) const;
+  /// Whether a stored single-triangle fragment contains `t` and is nearer than or level with
+  /// it all over the pixel (so t, being later, shows nowhere): many copies of one triangle.
+  bool hidden_by_container(std::size_t pixel, int x, int y, const TriangleSetup& t) const;
+  /// Removes the fragments for which `drop(fragment)` holds from the pixel's list.
+  template <class Drop>
+  void remove_fragments(std::size_t pixel, Drop drop);
   /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
   bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
                        std::uint32_t coverage);
   /// Merges a piece (coverage, sample mask, colour at the pixel centre) into fragment `f`.
   void merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask, glm::vec3 color,
-                  int x, int y);
+                  int x, int y, const TriangleSetup* const* pieces, int piece_count);
+  /// Overflow of a pixel, by a fragment that joins its open set: merges it into an open
+  /// member, keeping the pieces and the exact sums; false when no member has room for another
+  /// piece.
+  bool merge_into_open_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                           std::uint32_t coverage, double centre_z);
   /// The merged data of fragment `f` (which has kMergedFlag).
   const MergedPiece& merged_piece(std::uint32_t f) const { return merged_[merged_slot_[f]]; }
   void sample_weights(int x, int y, const TriangleSetup* opaque, int n,
                       const TriangleSetup* const* tri, const std::uint32_t* cov,
                       const MergedPiece* const* merged, double* weight) const;
+  /// Marks in `exact` the fragments that keep their exact area: in front of the opaque
+  /// surface, and every other fragment either misses them (a separating edge) or lies
+  /// behind them all over the pixel.
+  static void unhidden_fragments(int x, int y, const TriangleSetup* opaque, int n,
+                                 const TriangleSetup* const* tri, const MergedPiece* const* merged,
+                                 bool* exact);
   /// Writes the pixels `r` that show `opaque` (null: the background) alone into the frame.
   void resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
                             const FrameTarget& target);
@@ -182,28 +249,26 @@ class ABufferTile {
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
-  /// Per pixel, whether its fragments so far are one layer: all of one mesh instance and
-  /// facing, each sharing a vertex with one that came before it (so the layer is connected
-  /// and its pieces do not overlap). The one before it and the first are tried first (the
-  /// first helps where a tessellation's next row of triangles starts), the rest of the list
-  /// only when both fail (where dozens of triangles meet, e.g. at a sphere's pole). Such a
-  /// pixel with no opaque surface resolves from the sums alone, to exactly what the list
-  /// would give (the front-layer formula of resolve_pixel).
-  enum class Layer : std::uint8_t { Empty, One, Mixed };
+  /// Per pixel: Empty (no fragments), One (every fragment is in the open set, so they are
+  /// pairwise disjoint and layer_sums_ describes them all), Mixed, or Overflowed (the list
+  /// has merged or dropped fragments: no sets are kept, only the list knows).
+  enum class Layer : std::uint8_t { Empty, One, Mixed, Overflowed };
+  /// Running sums of the pixel's open set, or of its closed set while that is all there is.
   struct LayerSums {
-    std::uint32_t key;       ///< surface * 2 + front_facing
     std::uint32_t coverage;  ///< sum of the fragments' 8.8 coverage
     double rgb[3];           ///< sum of coverage * linear colour, in list order
     float depth;             ///< nearest centre depth
-    /// The layer's first and latest triangles (the list's head and tail, kept here so that
-    /// the join test reads them without going through the list).
-    const TriangleSetup* first;
-    const TriangleSetup* last;
+    double far;              ///< farthest depth any member reaches in the pixel
   };
   /// Colour of a layer in front of everything else (abuffer.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
   std::vector<Layer> layer_;
   std::vector<LayerSums> layer_sums_;
+  std::vector<std::uint8_t> open_count_;    ///< per pixel, fragments in the open set
+  std::vector<std::uint8_t> closed_count_;  ///< per pixel, fragments in the closed set
+  /// Per pixel, a depth at or behind which nothing is visible: the farthest depth of the
+  /// closed sets so far (+inf: none).
+  std::vector<double> occluder_z_;
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
   std::vector<MergedPiece> merged_;
@@ -239,6 +304,8 @@ inline void ABufferTile::prepare_row(int x0, int x1, int y) {
 inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                              double centre_z) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+  if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set
+  if (closed_count_[pixel] != 0 && hidden_by_closed_set(pixel, x, y, *t, centre_z)) return;
   if (opaque_[pixel] == nullptr) {
     if (coverage == std::uint32_t(kCoverageOne)) {
       opaque_[pixel] = t;
@@ -264,39 +331,18 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
   add_fragment(pixel, x, y, t, coverage, centre_z);
 }
 
-inline void ABufferTile::track_layer(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                                     std::uint32_t coverage, double centre_z) {
-  const std::uint32_t key = t->surface * 2 + (t->front_facing ? 1 : 0);
-  LayerSums& sums = layer_sums_[pixel];
-  if (layer_[pixel] == Layer::Empty) {
-    layer_[pixel] = Layer::One;
-    sums.key = key;
-    sums.coverage = 0;
-    sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
-    sums.depth = std::numeric_limits<float>::infinity();
-    sums.first = t;
-  } else if (layer_[pixel] == Layer::Mixed) {
-    return;
-  } else if (sums.key != key || !(share_vertex(*t, *sums.last) || share_vertex(*t, *sums.first) ||
-                                  joins_list(pixel, *t))) {
-    layer_[pixel] = Layer::Mixed;
-    return;
-  }
-  sums.last = t;
-  const glm::vec3 c = shade(*t, x + 0.5, y + 0.5, true);
-  sums.coverage += coverage;
-  sums.rgb[0] += double(coverage) * c.r;
-  sums.rgb[1] += double(coverage) * c.g;
-  sums.rgb[2] += double(coverage) * c.b;
-  sums.depth = std::min(sums.depth, float(centre_z));
-}
-
 inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                       std::uint32_t coverage, double centre_z) {
-  if (count_[pixel] >= capacity_ && overflow_fragment(pixel, x, y, t, coverage)) return;
-  track_layer(pixel, x, y, t, coverage, centre_z);
-  std::uint32_t index = std::uint32_t(pool_.size());
-  pool_.push_back(Fragment{t, kEnd, coverage});
+  if (count_[pixel] >= capacity_ && overflow_fragment(pixel, x, y, t, coverage, centre_z)) return;
+  std::uint32_t flags = 0;
+  if (layer_[pixel] != Layer::Overflowed && joins_open_set(pixel, *t)) {
+    flags = kOpenFlag;
+    add_to_sums(pixel, x, y, *t, coverage, centre_z);
+  } else if (hidden_by_container(pixel, x, y, *t)) {
+    return;
+  }
+  const std::uint32_t index = std::uint32_t(pool_.size());
+  pool_.push_back(Fragment{t, kEnd, coverage | flags});
   if (head_[pixel] == kEnd) {
     head_[pixel] = index;
   } else {
@@ -304,6 +350,50 @@ inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const Tri
   }
   tail_[pixel] = index;
   ++count_[pixel];
+  if (layer_[pixel] == Layer::Overflowed) return;
+  if (flags == 0) {
+    layer_[pixel] = Layer::Mixed;
+    return;
+  }
+  ++open_count_[pixel];
+  layer_[pixel] = open_count_[pixel] == count_[pixel] ? Layer::One : Layer::Mixed;
+  if (layer_sums_[pixel].coverage >= std::uint32_t(kCoverageOne)) complete_open_set(pixel, x, y);
+}
+
+inline bool ABufferTile::joins_open_set(std::size_t pixel, const TriangleSetup& t) const {
+  if (open_count_[pixel] == 0) return true;
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kOpenFlag)) continue;
+    if (!(pool_[f].coverage & kMergedFlag)) {
+      if (!interiors_disjoint(t, *pool_[f].triangle)) return false;
+      continue;
+    }
+    const TriangleSetup* const* pieces;
+    const int count = fragment_pieces(f, pieces);
+    if (count < 0) return false;
+    for (int k = 0; k < count; ++k) {
+      if (!interiors_disjoint(t, *pieces[k])) return false;
+    }
+  }
+  return true;
+}
+
+inline void ABufferTile::add_to_sums(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                                     std::uint32_t coverage, double centre_z) {
+  LayerSums& sums = layer_sums_[pixel];
+  if (open_count_[pixel] == 0) {
+    sums.coverage = 0;
+    sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
+    sums.depth = std::numeric_limits<float>::infinity();
+    sums.far = -std::numeric_limits<double>::infinity();
+  }
+  const glm::vec3 c = shade(t, x + 0.5, y + 0.5, true);
+  sums.coverage += coverage;
+  sums.rgb[0] += double(coverage) * c.r;
+  sums.rgb[1] += double(coverage) * c.g;
+  sums.rgb[2] += double(coverage) * c.b;
+  sums.depth = std::min(sums.depth, float(centre_z));
+  sums.far = std::max(sums.far, centre_z + depth_reach(t));
 }
 
 }  // namespace covrast::detail

@@ -83,7 +83,7 @@ void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec
     if (target.depth != nullptr && depth != nullptr) {
       const float* dsrc = depth + std::size_t(y - rect.y0) * stride;
       float* ddst = &target.depth->depth[std::size_t(y) * target.depth->width + rect.x0];
-      for (int x = rect.x0; x < rect.x1; ++x) *ddst++ = std::min(*dsrc++, 1.0f);
+      for (int x = rect.x0; x < rect.x1; ++x) *ddst++ = clamp_window_depth(*dsrc++);
     }
   }
 }

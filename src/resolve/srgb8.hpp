@@ -14,6 +14,12 @@ namespace covrast::detail {
 /// 255 linear values where the 8-bit code changes: exact, and identical on every path.
 std::uint8_t encode_srgb8(float linear);
 
+/// A window depth as the depth outputs store it, in [0, 1]: a plane evaluated at a pixel
+/// centre outside its triangle (a sliver's, steep) can leave the range; NaN becomes 1.
+inline float clamp_window_depth(float z) {
+  return z >= 0.0f ? (z < 1.0f ? z : 1.0f) : (z < 0.0f ? 0.0f : 1.0f);
+}
+
 /// Writes a tile's linear colours (row stride `stride` pixels) as 8-bit sRGB, and, when the
 /// target wants depth, its window depths, into the frame.
 void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec3* linear,
