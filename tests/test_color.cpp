@@ -68,3 +68,15 @@ TEST_CASE("lowbias32 and the per_triangle colour follow the formula", "[scene][c
   const glm::vec3 c0 = covrast::per_triangle_color_srgb(0u);
   REQUIRE(c0 == glm::vec3(0.0f));
 }
+
+TEST_CASE("per_triangle colour in linear light is srgb_to_linear of the sRGB one, bit for bit",
+          "[scene][color]") {
+  for (std::uint32_t i = 0; i < 100000; i += 7) {
+    const glm::vec3 s = covrast::per_triangle_color_srgb(i);
+    const glm::vec3 l = covrast::per_triangle_color_linear(i);
+    INFO("triangle " << i);
+    CHECK(l.r == covrast::srgb_to_linear(s.r));
+    CHECK(l.g == covrast::srgb_to_linear(s.g));
+    CHECK(l.b == covrast::srgb_to_linear(s.b));
+  }
+}

@@ -101,6 +101,9 @@ std::shared_ptr<MeshData> load_mesh(const std::filesystem::path& path);
 /// 255) / 255, b = (h >> 16 & 255) / 255, as sRGB display values.
 std::uint32_t lowbias32(std::uint32_t x);
 glm::vec3 per_triangle_color_srgb(std::uint32_t global_triangle_index);
+/// The same colour in linear light: srgb_to_linear of each channel, bit for bit, from a
+/// 256-entry table (the set-up asks for one per triangle).
+glm::vec3 per_triangle_color_linear(std::uint32_t global_triangle_index);
 
 /// sRGB transfer function (IEC 61966-2-1), both directions, on [0, 1].
 float srgb_to_linear(float encoded);

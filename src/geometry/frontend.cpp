@@ -381,8 +381,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
           flat = uniform_flat;
           break;
         case ColorSource::PerTriangle: {
-          const glm::vec3 c = per_triangle_color_srgb(primitive);
-          triangle_color = glm::vec3(srgb_to_linear(c.r), srgb_to_linear(c.g), srgb_to_linear(c.b));
+          triangle_color = per_triangle_color_linear(primitive);
           c0 = c1 = c2 = &triangle_color;
           flat = triangle_color == triangle_color;
           break;

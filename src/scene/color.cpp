@@ -2,6 +2,7 @@
 // the sRGB display values of scene files into linear light, and the per_triangle debug colour.
 #include <covrast/scene.hpp>
 
+#include <array>
 #include <cmath>
 
 namespace covrast {
@@ -39,6 +40,16 @@ glm::vec3 per_triangle_color_srgb(std::uint32_t global_triangle_index) {
   const std::uint32_t h = lowbias32(global_triangle_index);
   return {static_cast<float>(h & 255u) / 255.0f, static_cast<float>((h >> 8) & 255u) / 255.0f,
           static_cast<float>((h >> 16) & 255u) / 255.0f};
+}
+
+glm::vec3 per_triangle_color_linear(std::uint32_t global_triangle_index) {
+  static const std::array<float, 256> table = [] {
+    std::array<float, 256> t{};
+    for (std::uint32_t k = 0; k < 256; ++k) t[k] = srgb_to_linear(static_cast<float>(k) / 255.0f);
+    return t;
+  }();
+  const std::uint32_t h = lowbias32(global_triangle_index);
+  return {table[h & 255u], table[(h >> 8) & 255u], table[(h >> 16) & 255u]};
 }
 
 }  // namespace covrast
