@@ -1,4 +1,5 @@
-// covrast-scenegen: writes the committed test scenes (JSON + OBJ) into a directory.
+// covrast-scenegen: writes the committed test scenes (JSON + OBJ) into a directory, or with
+// --real DIR the real-content set (not committed; scenes/README.md).
 //
 // A standalone tool (it does not link the covrast library): every number is computed in
 // double precision with a fixed formula and written with printf("%.9g"), so the output bytes
