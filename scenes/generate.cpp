@@ -1,4 +1,5 @@
-// covrast-scenegen: writes the committed test scenes (JSON + OBJ) into a directory.
+// covrast-scenegen: writes the committed test scenes (JSON + OBJ) into a directory, or with
+// --real DIR the real-content set (not committed; scenes/README.md).
 //
 // A standalone tool (it does not link the covrast library): every number is computed in
 // double precision with a fixed formula and written with printf("%.9g"), so the output bytes
@@ -14,9 +15,12 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace covrast::scenegen {
@@ -414,16 +418,24 @@ constexpr double kGridStepY = 2.2;
 
 /// 10 x 10 instances of the 5,000-triangle sphere (500,000 triangles). The grid spans
 /// x in [-16.3, 16.3], y in [-10.9, 10.9]; from z = 44 with fovy 30 deg the view at z = 0
-/// spans 44 tan(15 deg) = 11.8 up and 11.8 * 16 / 9 = 21.0 across.
-SceneFile make_sphere_grid() {
-  SceneFile scene{"sphere_grid.json", 1920, 1080, {0.08, 0.08, 0.1}, {}, {}};
+/// spans 44 tan(15 deg) = 11.8 up and 11.8 * 16 / 9 = 21.0 across. With per_triangle, every
+/// sphere is coloured "per_triangle" instead of its palette colour (the real-content set's
+/// sphere_grid_per_triangle.json); the rest of the file is the same.
+SceneFile make_sphere_grid(const std::string& file_name = "sphere_grid.json",
+                           bool per_triangle = false) {
+  SceneFile scene{file_name, 1920, 1080, {0.08, 0.08, 0.1}, {}, {}};
   scene.camera = {{0.0, 0.0, 44.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 30.0, 20.0, 80.0};
   for (int row = 0; row < kGridSide; ++row) {
     for (int col = 0; col < kGridSide; ++col) {
       const double x = (col - (kGridSide - 1) / 2.0) * kGridStepX;
       const double y = ((kGridSide - 1) / 2.0 - row) * kGridStepY;
-      scene.instances.push_back(
-          rgb("sphere5k.obj", palette(row * kGridSide + col), translate(x, y, 0.0)));
+      if (per_triangle) {
+        scene.instances.push_back(
+            Instance{"sphere5k.obj", Instance::Color::PerTriangle, {}, translate(x, y, 0.0)});
+      } else {
+        scene.instances.push_back(
+            rgb("sphere5k.obj", palette(row * kGridSide + col), translate(x, y, 0.0)));
+      }
     }
   }
   return scene;
@@ -449,6 +461,659 @@ SceneFile make_overlap() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// The real-content set (--real DIR): scenes that look like what real models contain (dense
+// folded surfaces, pleats, knots, interpenetration, open parts, decals, CAD assemblies, stacked
+// copies). Not committed (some meshes are megabytes of OBJ); written on demand with the same
+// determinism rules as the committed set. The only pseudo-randomness is hash32 below.
+
+Vec3 operator+(const Vec3& a, const Vec3& b) { return {a[0] + b[0], a[1] + b[1], a[2] + b[2]}; }
+Vec3 operator-(const Vec3& a, const Vec3& b) { return {a[0] - b[0], a[1] - b[1], a[2] - b[2]}; }
+Vec3 operator*(double s, const Vec3& v) { return {s * v[0], s * v[1], s * v[2]}; }
+double dot(const Vec3& a, const Vec3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+Vec3 cross(const Vec3& a, const Vec3& b) {
+  return {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
+}
+Vec3 normalized(const Vec3& v) { return (1.0 / std::sqrt(dot(v, v))) * v; }
+
+/// M * (p, 1) for an affine M.
+Vec3 transform_point(const Mat4& m, const Vec3& p) {
+  Vec3 out{};
+  for (int row = 0; row < 3; ++row) {
+    out[row] = m[row][0] * p[0] + m[row][1] * p[1] + m[row][2] * p[2] + m[row][3];
+  }
+  return out;
+}
+
+Mat4 scale_xyz(double x, double y, double z) {
+  Mat4 m = identity();
+  m[0][0] = x;
+  m[1][1] = y;
+  m[2][2] = z;
+  return m;
+}
+
+/// The fixed integer hash (lowbias32, the same one covrast uses for per_triangle colours).
+std::uint32_t hash32(std::uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+/// A deterministic value in [lo, hi) for (stream, index): exact integer arithmetic, then one
+/// exact conversion and one rounded multiply-add, so every platform gives the same double.
+double hashed(std::uint32_t stream, std::uint32_t index, double lo, double hi) {
+  const std::uint32_t h = hash32(hash32(stream * 0x9e3779b9u + 0x632be5abu) ^ index);
+  return lo + (hi - lo) * (double(h) / 4294967296.0);
+}
+
+/// Adds a grid of vertices position(i, j), i in 0..nu, j in 0..nv, and the 2 nu nv triangles
+/// of its quads (i, j), (i+1, j), (i+1, j+1), (i, j+1), each split along its first diagonal, so
+/// that each triangle's normal points along dP/di x dP/dj. With wrap_u (wrap_v) the column
+/// i = nu (row j = nv) is column 0 (row 0) again: a tube or a torus with shared seam vertices.
+template <class Position>
+void add_grid(Mesh& mesh, int nu, int nv, bool wrap_u, bool wrap_v, Position position) {
+  const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+  const int columns = wrap_u ? nu : nu + 1;
+  const int rows = wrap_v ? nv : nv + 1;
+  for (int i = 0; i < columns; ++i) {
+    for (int j = 0; j < rows; ++j) mesh.positions.push_back(position(i, j));
+  }
+  const auto at = [base, columns, rows](int i, int j) {
+    return base + static_cast<std::uint32_t>((i % columns) * rows + j % rows);
+  };
+  for (int i = 0; i < nu; ++i) {
+    for (int j = 0; j < nv; ++j) {
+      mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+}
+
+/// Drops the vertices no triangle uses (keeping the others in order) and renumbers.
+void drop_unused_vertices(Mesh& mesh) {
+  constexpr auto kUnused = ~std::uint32_t{0};
+  std::vector<std::uint32_t> new_index(mesh.positions.size(), kUnused);
+  for (const auto& t : mesh.triangles) {
+    for (const std::uint32_t v : t) new_index[v] = 0;
+  }
+  std::vector<Vec3> kept;
+  for (std::size_t v = 0; v < mesh.positions.size(); ++v) {
+    if (new_index[v] == kUnused) continue;
+    new_index[v] = static_cast<std::uint32_t>(kept.size());
+    kept.push_back(mesh.positions[v]);
+  }
+  mesh.positions = std::move(kept);
+  for (auto& t : mesh.triangles) {
+    for (std::uint32_t& v : t) v = new_index[v];
+  }
+}
+
+// --- folded_sphere -----------------------------------------------------------------------------
+
+constexpr int kFoldedSphereCells = 144;  ///< grid cells per cube face: 6 * 2 * 144^2 triangles
+
+/// The radial displacement of the folded sphere at unit direction d: four plane waves of
+/// wavelength 0.44..0.74 (smooth everywhere on the sphere, poles included), 0.2 at most in
+/// all. Their slopes (amplitude x wave number, 0.5..0.7 each) add up to 1 and more in places,
+/// tilting the surface by 45 deg and beyond, so near the silhouette the bumps turn away from
+/// the camera and fold behind one another.
+double folded_sphere_displacement(const Vec3& d) {
+  return 0.06 * std::sin(8.0 * d[0] + 3.0 * d[1] + 0.4) +
+         0.05 * std::sin(-4.0 * d[0] + 9.0 * d[1] + 5.0 * d[2] + 1.3) +
+         0.05 * std::sin(3.0 * d[0] - 7.0 * d[1] + 11.0 * d[2] + 2.2) +
+         0.04 * std::sin(13.0 * d[0] + 6.0 * d[2] - 0.7);
+}
+
+using Lattice = std::array<int, 3>;
+
+/// Adds the surface of the cube [0, n]^3 of the integer lattice: each face an n x n grid of
+/// quads split along their first diagonal, 12 n^2 triangles, with the vertex of lattice point l
+/// at position(l). A point on an edge or corner of the cube is one vertex shared by its faces,
+/// so the mesh is closed; each face runs along (u, v) with u x v outwards, so it is wound
+/// counter-clockwise seen from outside (for any position() that keeps the cube's shape
+/// star-shaped about its centre).
+template <class Position>
+void add_lattice_cube(Mesh& mesh, int n, Position position) {
+  struct Face {
+    Lattice origin, u, v;
+  };
+  const std::array<Face, 6> faces = {{
+      {{n, 0, 0}, {0, 1, 0}, {0, 0, 1}},  // +x
+      {{0, 0, 0}, {0, 0, 1}, {0, 1, 0}},  // -x
+      {{0, n, 0}, {0, 0, 1}, {1, 0, 0}},  // +y
+      {{0, 0, 0}, {1, 0, 0}, {0, 0, 1}},  // -y
+      {{0, 0, n}, {1, 0, 0}, {0, 1, 0}},  // +z
+      {{0, 0, 0}, {0, 1, 0}, {1, 0, 0}},  // -z
+  }};
+  std::map<Lattice, std::uint32_t> vertex_of;
+  const auto vertex = [&](const Lattice& l) {
+    const auto [it, inserted] =
+        vertex_of.emplace(l, static_cast<std::uint32_t>(mesh.positions.size()));
+    if (inserted) mesh.positions.push_back(position(l));
+    return it->second;
+  };
+  for (const Face& f : faces) {
+    const auto at = [&f](int i, int j) {
+      return Lattice{f.origin[0] + i * f.u[0] + j * f.v[0], f.origin[1] + i * f.u[1] + j * f.v[1],
+                     f.origin[2] + i * f.u[2] + j * f.v[2]};
+    };
+    for (int i = 0; i < n; ++i) {
+      for (int j = 0; j < n; ++j) {
+        const std::uint32_t a = vertex(at(i, j));
+        const std::uint32_t b = vertex(at(i + 1, j));
+        const std::uint32_t c = vertex(at(i + 1, j + 1));
+        const std::uint32_t d = vertex(at(i, j + 1));
+        mesh.triangles.push_back({a, b, c});
+        mesh.triangles.push_back({a, c, d});
+      }
+    }
+  }
+}
+
+/// A cube sphere (add_lattice_cube, each lattice point mapped to [-1, 1]^3, pushed out to the
+/// unit sphere with the equal-angle warp tan(pi/4 c)) displaced radially by
+/// folded_sphere_displacement: closed and wound outwards. A radial displacement of a
+/// star-shaped surface cannot make it cross itself.
+Mesh make_folded_sphere_mesh() {
+  constexpr int n = kFoldedSphereCells;
+  Mesh mesh;
+  mesh.file_name = "folded_sphere.obj";
+  mesh.description =
+      "closed cube sphere, 6 faces of 144 x 144 cells, radius 1 displaced radially by four "
+      "plane waves (up to +-0.2), counter-clockwise seen from outside";
+  add_lattice_cube(mesh, n, [](const Lattice& l) {
+    Vec3 w{};
+    for (int k = 0; k < 3; ++k) w[k] = std::tan(0.25 * kPi * (2.0 * l[k] / n - 1.0));
+    const Vec3 d = normalized(w);
+    return (1.0 + folded_sphere_displacement(d)) * d;
+  });
+  return mesh;
+}
+
+SceneFile make_folded_sphere() {
+  SceneFile scene{"folded_sphere.json", 640, 360, {0.05, 0.05, 0.07}, {}, {}};
+  scene.camera = {{1.05, 0.8, 3.5}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 45.0, 2.0, 6.0};
+  scene.instances.push_back(
+      Instance{"folded_sphere.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// --- pleated_sheet -----------------------------------------------------------------------------
+
+constexpr int kPleats = 24;             ///< ridge-to-ridge periods along x
+constexpr int kPleatSlopeCells = 4;     ///< cells across each slope
+constexpr int kPleatLengthCells = 120;  ///< cells along the fold lines (z)
+constexpr double kPleatPeriod = 0.5;
+constexpr double kPleatHeight = 0.25;
+constexpr double kPleatHalfWidth = 6.0;
+
+/// An open accordion: x from 0 to 24 * 0.5, y a zig-zag between 0 (valleys) and 0.25 (ridges)
+/// with straight slopes, z in [-6, 6]. Slopes and fold lines come from integer grid indices, so
+/// ridges and valleys are exact mesh edges. Counter-clockwise seen from above (+y).
+Mesh make_pleated_sheet_mesh() {
+  Mesh mesh;
+  mesh.file_name = "pleated_sheet.obj";
+  mesh.description =
+      "open zig-zag sheet: 24 pleats of period 0.5 and height 0.25 along x, z in [-6, 6]";
+  const int nx = kPleats * 2 * kPleatSlopeCells;
+  add_grid(mesh, kPleatLengthCells, nx, false, false, [](int i, int j) {
+    const int k = j % (2 * kPleatSlopeCells);
+    const int up = k <= kPleatSlopeCells ? k : 2 * kPleatSlopeCells - k;
+    return Vec3{j * (kPleatPeriod / (2 * kPleatSlopeCells)), kPleatHeight * up / kPleatSlopeCells,
+                -kPleatHalfWidth + i * (2.0 * kPleatHalfWidth / kPleatLengthCells)};
+  });
+  return mesh;
+}
+
+/// The camera stands 0.17 above the ridges' height at the near end and looks across the fold
+/// lines, 29 deg off the x axis: the near pleats are seen from above, the far ones at grazing
+/// angles, so each ridge hides the slope behind it and the next valley.
+SceneFile make_pleated_sheet() {
+  SceneFile scene{"pleated_sheet.json", 640, 360, {0.55, 0.65, 0.8}, {}, {}};
+  scene.camera = {{-0.6, 0.42, -2.2}, {6.0, 0.0, 1.4}, {0.0, 1.0, 0.0}, 45.0, 0.3, 20.0};
+  scene.instances.push_back(
+      Instance{"pleated_sheet.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// --- tubes swept along curves ------------------------------------------------------------------
+
+/// A tube of the given radius around the curve point(t), t in [0, 1], with `along` rings
+/// (along + 1 when open) of `around` vertices. The ring frame is n = normalize(tangent x
+/// reference), b = tangent x n (reference must never be parallel to the tangent). Closed
+/// curves (point(0) == point(1)) share the first ring, so the tube has no seam; the winding
+/// is counter-clockwise seen from outside.
+template <class Curve>
+void add_swept_tube(Mesh& mesh, Curve point, bool closed_curve, int along, int around,
+                    double radius, const Vec3& reference) {
+  const auto frame_point = [&](int i, int j) {
+    const double t = double(i) / along;
+    const double h = 1e-5;
+    const Vec3 tangent = normalized(point(t + h) - point(t - h));
+    const Vec3 n = normalized(cross(tangent, reference));
+    const Vec3 b = cross(tangent, n);
+    const double phi = 2.0 * kPi * j / around;
+    return point(t) + radius * (std::cos(phi) * n + std::sin(phi) * b);
+  };
+  // dP/dphi x dP/dt = (-sin n + cos b) x tangent = outwards, so phi is the first index.
+  add_grid(mesh, around, along, true, closed_curve,
+           [&frame_point](int j, int i) { return frame_point(i, j); });
+}
+
+// --- torus_knot --------------------------------------------------------------------------------
+
+constexpr int kKnotAlong = 640;
+constexpr int kKnotAround = 64;
+
+/// The (2, 3) torus knot (a trefoil): ((2 + cos 3s) cos 2s, (2 + cos 3s) sin 2s, -sin 3s) * 0.45
+/// for s in [0, 2 pi], a closed curve whose tangent is never parallel to z. Tube radius 0.16
+/// (the centre lines of two strands come no closer than 0.75, at the crossings).
+Mesh make_torus_knot_mesh() {
+  Mesh mesh;
+  mesh.file_name = "torus_knot.obj";
+  mesh.description =
+      "closed tube of radius 0.16 around the (2, 3) torus knot, 640 x 64 cells, "
+      "counter-clockwise seen from outside";
+  const auto knot = [](double t) {
+    const double s = 2.0 * kPi * t;
+    const double r = 2.0 + std::cos(3.0 * s);
+    return Vec3{0.45 * r * std::cos(2.0 * s), 0.45 * r * std::sin(2.0 * s),
+                -0.45 * std::sin(3.0 * s)};
+  };
+  add_swept_tube(mesh, knot, true, kKnotAlong, kKnotAround, 0.16, {0.0, 0.0, 1.0});
+  return mesh;
+}
+
+SceneFile make_torus_knot() {
+  SceneFile scene{"torus_knot.json", 640, 360, {0.1, 0.1, 0.12}, {}, {}};
+  scene.camera = {{0.6, -1.4, 3.3}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.5, 6.0};
+  scene.instances.push_back(
+      Instance{"torus_knot.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// --- interpenetrating --------------------------------------------------------------------------
+
+/// Closed cube [-0.5, 0.5]^3 with each face an n x n grid (add_lattice_cube; lattice point k
+/// at k / n - 0.5), wound counter-clockwise seen from outside.
+Mesh make_grid_box(const std::string& file_name, int n) {
+  Mesh mesh;
+  mesh.file_name = file_name;
+  mesh.description = "closed cube [-0.5, 0.5]^3, each face " + std::to_string(n) + " x " +
+                     std::to_string(n) + " cells, counter-clockwise seen from outside";
+  add_lattice_cube(mesh, n, [n](const Lattice& l) {
+    return Vec3{double(l[0]) / n - 0.5, double(l[1]) / n - 0.5, double(l[2]) / n - 0.5};
+  });
+  return mesh;
+}
+
+/// A sphere of radius 1 pierced by a long rotated bar (the 16 x 16-cell box scaled to
+/// 2.8 x 0.55 x 0.55) that comes out on both sides: intersection curves that are no mesh
+/// edges, on two closed meshes whose back faces are culled.
+SceneFile make_interpenetrating() {
+  SceneFile scene{"interpenetrating.json", 640, 360, {0.12, 0.12, 0.16}, {}, {}};
+  scene.camera = {{1.2, 0.9, 3.4}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.0, 8.0};
+  scene.instances.push_back(
+      Instance{"interpenetrating_sphere.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  scene.instances.push_back(Instance{
+      "interpenetrating_box.obj",
+      Instance::Color::PerTriangle,
+      {},
+      translate(0.1, 0.15, 0.2) * rotate(25.0, {0.0, 0.0, 1.0}) * rotate(35.0, {0.0, 1.0, 0.0}) *
+          rotate(20.0, {1.0, 0.0, 0.0}) * scale_xyz(2.8, 0.55, 0.55)});
+  return scene;
+}
+
+// --- open_parts --------------------------------------------------------------------------------
+
+constexpr int kShellSegments = 160;
+constexpr int kShellRings = 64;
+constexpr double kShellThetaMaxDeg = 130.0;
+constexpr double kEyeRadius = 0.17;
+
+/// The two eye directions on the shell (unit vectors) and the angular radius of the socket
+/// cut around each: the left socket is wider than the eyeball (a gap shows the shell's
+/// inside), the right one narrower (the shell cuts through the eyeball around it).
+struct Socket {
+  Vec3 direction;
+  double hole_radius;
+};
+std::array<Socket, 2> sockets() {
+  return {{{normalized({-0.36, 0.12, 0.92}), 0.215}, {normalized({0.36, 0.12, 0.92}), 0.13}}};
+}
+
+/// An open spherical shell like a head with an open neck: radius 1, from the top pole (+y) to
+/// theta = 130 deg (the neck opening faces -y), with two round sockets cut out of its front
+/// (+z), the triangles whose centres lie within each socket's radius: the neck rim and the
+/// socket edges are open. Pole fan plus rings as in make_uv_sphere (the same vertex formula),
+/// counter-clockwise seen from outside.
+Mesh make_shell_mesh() {
+  Mesh mesh;
+  mesh.file_name = "open_parts_shell.obj";
+  mesh.description =
+      "open spherical shell of radius 1, theta 0..130 deg from +y, 160 segments x 64 rings, "
+      "two sockets cut out, counter-clockwise seen from outside";
+  mesh.positions.push_back({0.0, 1.0, 0.0});
+  for (int i = 1; i <= kShellRings; ++i) {
+    const double theta = radians(kShellThetaMaxDeg) * i / kShellRings;
+    for (int j = 0; j < kShellSegments; ++j) {
+      const double phi = 2.0 * kPi * j / kShellSegments;
+      mesh.positions.push_back(
+          {std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi)});
+    }
+  }
+  const auto at = [](int ring, int segment) {
+    return static_cast<std::uint32_t>(1 + (ring - 1) * kShellSegments + segment % kShellSegments);
+  };
+  std::vector<std::array<std::uint32_t, 3>> all;
+  for (int j = 0; j < kShellSegments; ++j) all.push_back({0, at(1, j), at(1, j + 1)});
+  for (int i = 1; i < kShellRings; ++i) {
+    for (int j = 0; j < kShellSegments; ++j) {
+      all.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      all.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  }
+  const std::array<Socket, 2> cut = sockets();
+  for (const auto& t : all) {
+    const Vec3 centre =
+        normalized(mesh.positions[t[0]] + mesh.positions[t[1]] + mesh.positions[t[2]]);
+    bool keep = true;
+    for (const Socket& s : cut) {
+      if (std::acos(std::min(1.0, dot(centre, s.direction))) < s.hole_radius) keep = false;
+    }
+    if (keep) mesh.triangles.push_back(t);
+  }
+  drop_unused_vertices(mesh);
+  return mesh;
+}
+
+/// The shell seen from the front left (20 deg) and a little from below, so the front of the
+/// neck rim shows with the shell's inside (its back faces) beyond it, and the gap round the
+/// wide socket's eyeball shows the inside too; two closed eyeballs (radius 0.17, back faces
+/// culled) sit half sunk in the sockets.
+SceneFile make_open_parts() {
+  SceneFile scene{"open_parts.json", 640, 360, {0.2, 0.22, 0.25}, {}, {}};
+  scene.camera = {{-1.02, -0.42, 2.79}, {0.0, -0.05, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.0, 6.0};
+  scene.instances.push_back(
+      Instance{"open_parts_shell.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  for (const Socket& s : sockets()) {
+    const Vec3 c = 0.98 * s.direction;
+    scene.instances.push_back(Instance{"open_parts_eye.obj",
+                                       Instance::Color::PerTriangle,
+                                       {},
+                                       translate(c[0], c[1], c[2]) * scale(kEyeRadius)});
+  }
+  return scene;
+}
+
+// --- decals ------------------------------------------------------------------------------------
+
+constexpr int kCoplanarDecals = 14;
+
+/// Adds the quad centre + (+-a, 0, +-b) rotated by angle_deg about y, at height y, as a
+/// 2 x 2 grid (8 triangles) wound counter-clockwise seen from above.
+void add_floor_quad(Mesh& mesh, double cx, double cz, double a, double b, double angle_deg,
+                    double y) {
+  const double c = std::cos(radians(angle_deg));
+  const double s = std::sin(radians(angle_deg));
+  add_grid(mesh, 2, 2, false, false, [=](int i, int j) {
+    const double u = a * (j - 1);  // along the quad's x
+    const double v = b * (i - 1);  // along the quad's z
+    return Vec3{cx + c * u + s * v, y, cz - s * u + c * v};
+  });
+}
+
+/// A 4 x 4 floor [-2, 2]^2 at y = 0, then 14 decals exactly in its plane (y written as 0),
+/// overlapping it and one another, then four near it: 0.01, 0.001 and 0.0001 above and 0.0001
+/// below. One OBJ, so the file order is the draw order: floor first.
+Mesh make_decals_mesh() {
+  Mesh mesh;
+  mesh.file_name = "decals.obj";
+  mesh.description =
+      "floor [-2, 2]^2 at y = 0, then 14 coplanar decal quads, then 4 offset by +0.01, "
+      "+0.001, +0.0001 and -0.0001";
+  add_grid(mesh, 4, 4, false, false, [](int i, int j) { return Vec3{-2.0 + j, 0.0, -2.0 + i}; });
+  for (int k = 0; k < kCoplanarDecals; ++k) {
+    const auto index = static_cast<std::uint32_t>(k);
+    add_floor_quad(mesh, hashed(1, index, -1.4, 1.4), hashed(2, index, -1.4, 1.4),
+                   hashed(3, index, 0.15, 0.55), hashed(4, index, 0.15, 0.55),
+                   hashed(5, index, 0.0, 90.0), 0.0);
+  }
+  const std::array<double, 4> offsets = {0.01, 0.001, 0.0001, -0.0001};
+  for (int k = 0; k < 4; ++k) {
+    add_floor_quad(mesh, -1.2 + 0.8 * k, 0.9 - 0.6 * k, 0.3, 0.3, 20.0 * k, offsets[k]);
+  }
+  return mesh;
+}
+
+SceneFile make_decals() {
+  SceneFile scene{"decals.json", 640, 360, {0.3, 0.3, 0.35}, {}, {}};
+  scene.camera = {{0.0, 2.3, 3.2}, {0.0, -0.2, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.0, 10.0};
+  scene.instances.push_back(Instance{"decals.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// --- cad_assembly ------------------------------------------------------------------------------
+
+/// An open cylinder wall of the given radius along the frame's local x from x0 to x1, with
+/// `around` x `rings` cells, its normals outwards (or inwards, for a tube's inner wall).
+void add_cylinder_wall(Mesh& mesh, const Mat4& frame, double radius, double x0, double x1,
+                       int around, int rings, bool outwards) {
+  add_grid(mesh, around, rings, true, false, [&](int j, int i) {
+    const double phi = 2.0 * kPi * (outwards ? j : around - j) / around;
+    return transform_point(
+        frame, {x0 + (x1 - x0) * i / rings, radius * std::cos(phi), radius * std::sin(phi)});
+  });
+}
+
+/// A tube with inner and outer walls and no end faces (open at both ends).
+void add_tube(Mesh& mesh, const Mat4& frame, double inner, double outer, double x0, double x1,
+              int around, int rings) {
+  add_cylinder_wall(mesh, frame, outer, x0, x1, around, rings, true);
+  add_cylinder_wall(mesh, frame, inner, x0, x1, around, rings, false);
+}
+
+/// A thin sheet: the profile curve (x(s), y(s)), s in [0, 1], extruded along local z over
+/// [-width / 2, width / 2], as two faces thickness / 2 either side of the profile (offset along
+/// its normal) with no rim: the sheet is open all round, like a CAD part exported without its
+/// edges' side faces. Each face's normals point away from the other.
+template <class Profile>
+void add_sheet(Mesh& mesh, const Mat4& frame, Profile profile, int cells_along, double width,
+               int cells_across, double thickness) {
+  for (const double side : {1.0, -1.0}) {
+    const auto point = [&, side](int i, int j) {
+      const double s = double(i) / cells_along;
+      const double h = 1e-5;
+      const std::array<double, 2> p = profile(s);
+      const std::array<double, 2> a = profile(std::max(0.0, s - h));
+      const std::array<double, 2> b = profile(std::min(1.0, s + h));
+      const double dx = b[0] - a[0];
+      const double dy = b[1] - a[1];
+      const double length = std::sqrt(dx * dx + dy * dy);
+      const double nx = -dy / length;
+      const double ny = dx / length;
+      return transform_point(
+          frame, {p[0] + side * 0.5 * thickness * nx, p[1] + side * 0.5 * thickness * ny,
+                  width * (double(j) / cells_across - 0.5)});
+    };
+    // dP/ds x dP/dz = (tangent, 0) x (0, 0, 1) = (ty, -tx, 0) = -normal: so the +side face
+    // runs (z, s) and the -side face (s, z).
+    if (side > 0.0) {
+      add_grid(mesh, cells_across, cells_along, false, false,
+               [&point](int j, int i) { return point(i, j); });
+    } else {
+      add_grid(mesh, cells_along, cells_across, false, false, point);
+    }
+  }
+}
+
+/// A flat plate sx x sz in the frame's local x-z plane (normal y), cells_x x cells_z cells.
+void add_plate(Mesh& mesh, const Mat4& frame, double sx, double sz, int cells_x, int cells_z,
+               double thickness) {
+  add_sheet(
+      mesh, frame,
+      [sx](double s) {
+        return std::array<double, 2>{sx * (s - 0.5), 0.0};
+      },
+      cells_x, sz, cells_z, thickness);
+}
+
+/// An annular plate across the frame's local x axis (radii inner..outer), two faces
+/// thickness / 2 either side of x = 0, no rims; `around` x `radial` cells per face.
+void add_annulus(Mesh& mesh, const Mat4& frame, double inner, double outer, int around, int radial,
+                 double thickness) {
+  const auto point = [&](double x, int i, int j) {
+    const double r = inner + (outer - inner) * i / radial;
+    const double phi = 2.0 * kPi * j / around;
+    return transform_point(frame, {x, r * std::cos(phi), r * std::sin(phi)});
+  };
+  // dP/dr x dP/dphi = +x.
+  add_grid(mesh, radial, around, false, true,
+           [&](int i, int j) { return point(0.5 * thickness, i, j); });
+  add_grid(mesh, around, radial, true, false,
+           [&](int j, int i) { return point(-0.5 * thickness, i, j); });
+}
+
+/// The L bracket's profile in the x-y plane, s in [0, 1] by arc length: a vertical leg of
+/// height `leg` down to a bend of radius 0.06, then a foot of length `foot` along +x at y = 0.
+std::array<double, 2> bracket_profile(double s, double leg, double foot) {
+  const double bend = 0.06;
+  const double arc = 0.5 * kPi * bend;
+  const double d = s * (leg + arc + foot);
+  if (d <= leg) return {0.0, leg + bend - d};
+  if (d <= leg + arc) {
+    const double a = (d - leg) / bend;  // 0..pi/2
+    return {bend - bend * std::cos(a), bend - bend * std::sin(a)};
+  }
+  return {bend + (d - leg - arc), 0.0};
+}
+
+/// A bolt along the frame's local x from x0: a shank (one ring: long thin triangles) and a
+/// hexagonal head (a 6-sided open prism), both single outward walls.
+void add_bolt(Mesh& mesh, const Mat4& frame, double x0, double length) {
+  add_cylinder_wall(mesh, frame, 0.025, x0, x0 + length, 32, 1, true);
+  add_cylinder_wall(mesh, frame, 0.045, x0 - 0.03, x0, 6, 1, true);
+}
+
+/// A machine-like assembly of open parts in one OBJ (as a glTF CAD export loads: one mesh,
+/// node transforms baked in). Along world x: a housing tube (outer and inner walls, no end
+/// faces), a motor can overlapping its end, nested shaft tubes through both, bearing rings,
+/// ribs (annular plates) that cut through the housing wall, radial cooling fins sunk into it,
+/// a base plate, L brackets whose legs pass through the housing, bolts (coarse tubes of long
+/// thin triangles) and a hose swept along a curve. Sheets are 0.01..0.03 thick with no rims.
+/// Placement uses fixed formulas and hashed(), nothing else.
+Mesh make_cad_assembly_mesh() {
+  Mesh mesh;
+  mesh.file_name = "cad_assembly.obj";
+  mesh.description =
+      "open CAD-like parts (housing, motor can, shafts, bearings, ribs, fins, base plate, "
+      "brackets, bolts, hose), no caps or rims";
+  const Mat4 axis = identity();
+  add_tube(mesh, axis, 0.86, 0.9, -1.5, 1.5, 160, 12);           // housing
+  add_tube(mesh, axis, 0.67, 0.7, 1.3, 2.3, 128, 8);             // motor can
+  add_tube(mesh, axis, 0.19, 0.2, -2.3, 2.0, 96, 24);            // outer shaft
+  add_tube(mesh, axis, 0.115, 0.12, -2.5, 2.5, 96, 24);          // inner shaft
+  add_cylinder_wall(mesh, axis, 0.06, -2.7, 2.6, 64, 24, true);  // rod
+  for (int k = 0; k < 8; ++k) {                                  // bearing rings on the outer shaft
+    const double x = -1.4 + 0.4 * k;
+    add_tube(mesh, axis, 0.205, 0.3, x, x + 0.08, 96, 2);
+  }
+  for (int k = 0; k < 10; ++k) {  // ribs through the housing wall
+    add_annulus(mesh, translate(-1.35 + 0.3 * k, 0.0, 0.0), 0.21, 0.96, 128, 6, 0.015);
+  }
+  for (int k = 0; k < 36; ++k) {  // cooling fins over the upper 3/4 of the housing
+    const auto index = static_cast<std::uint32_t>(k);
+    const double angle_deg = -135.0 + 270.0 * k / 35.0;
+    const double length = hashed(10, index, 1.6, 2.6);
+    const double height = hashed(11, index, 0.18, 0.3);
+    const Mat4 frame = rotate(angle_deg, {1.0, 0.0, 0.0}) *
+                       translate(hashed(12, index, -0.3, 0.3), 0.87 + 0.5 * height, 0.0) *
+                       rotate(90.0, {1.0, 0.0, 0.0});
+    add_plate(mesh, frame, length, height, 24, 4, 0.012);
+  }
+  add_plate(mesh, translate(0.0, -1.25, 0.0), 4.4, 2.2, 48, 24, 0.03);  // base plate
+  for (int k = 0; k < 16; ++k) {  // brackets on both sides, legs up through the housing
+    const auto index = static_cast<std::uint32_t>(k);
+    const double side = k % 2 == 0 ? 1.0 : -1.0;
+    const double x = -1.3 + 0.35 * (k / 2) + hashed(20, index, -0.05, 0.05);
+    const double leg = hashed(21, index, 0.65, 0.85);
+    const double foot = hashed(22, index, 0.2, 0.3);
+    const Mat4 frame = translate(x, -1.235, 0.72 * side) * rotate(-90.0 * side, {0.0, 1.0, 0.0});
+    add_sheet(
+        mesh, frame, [leg, foot](double s) { return bracket_profile(s, leg, foot); }, 24, 0.3, 6,
+        0.012);
+    for (const double along : {-0.08, 0.08}) {  // two bolts through the foot
+      const double reach = 0.72 + 0.06 + 0.6 * foot;
+      add_bolt(mesh, translate(x + along, -1.3, reach * side) * rotate(90.0, {0.0, 0.0, 1.0}), 0.0,
+               0.2);
+    }
+  }
+  for (int k = 0; k < 12; ++k) {  // bolts joining the housing end and the motor can
+    const double a = 2.0 * kPi * (k + 0.5) / 12.0;
+    add_bolt(mesh, translate(1.25, 0.78 * std::cos(a), 0.78 * std::sin(a)), 0.0, 0.35);
+  }
+  const auto hose = [](double t) {
+    return Vec3{-2.2 + 4.2 * t, 0.35 + 0.75 * std::sin(kPi * t),
+                0.95 + 0.2 * std::sin(3.0 * kPi * t)};
+  };
+  add_swept_tube(mesh, hose, false, 300, 48, 0.05, {0.0, 0.0, 1.0});
+  return mesh;
+}
+
+SceneFile make_cad_assembly() {
+  SceneFile scene{"cad_assembly.json", 640, 360, {0.85, 0.87, 0.9}, {}, {}};
+  scene.camera = {{2.6, 1.6, 3.3}, {0.05, -0.25, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.0, 12.0};
+  scene.instances.push_back(
+      Instance{"cad_assembly.obj", Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// --- stacked -----------------------------------------------------------------------------------
+
+constexpr int kStackedCopies = 2000;
+constexpr std::array<Vec3, 3> kStackedTriangle = {
+    {{-1.1, -0.85, 0.0}, {1.25, -0.55, 0.0}, {-0.15, 0.95, 0.0}}};
+
+/// The same triangle 2,000 times: three vertices, the face "f 1 2 3" repeated.
+Mesh make_stacked_mesh() {
+  Mesh mesh;
+  mesh.file_name = "stacked.obj";
+  mesh.description = "one triangle in the z = 0 plane, the same face 2000 times";
+  mesh.positions.assign(kStackedTriangle.begin(), kStackedTriangle.end());
+  mesh.triangles.assign(kStackedCopies, {0, 1, 2});
+  return mesh;
+}
+
+/// 2,000 copies of the stacked triangle, each with its own vertices moved by a hashed offset
+/// of up to +-0.02 in x and y (under half a pixel at 64x48) and +-0.005 in z.
+Mesh make_stacked_offset_mesh() {
+  Mesh mesh;
+  mesh.file_name = "stacked_offset.obj";
+  mesh.description =
+      "2000 copies of one triangle, each moved by up to +-0.02 in x, y and +-0.005 in z";
+  for (int k = 0; k < kStackedCopies; ++k) {
+    const auto index = static_cast<std::uint32_t>(k);
+    const Vec3 offset{hashed(30, index, -0.02, 0.02), hashed(31, index, -0.02, 0.02),
+                      hashed(32, index, -0.005, 0.005)};
+    const auto base = static_cast<std::uint32_t>(mesh.positions.size());
+    for (const Vec3& p : kStackedTriangle) mesh.positions.push_back(p + offset);
+    mesh.triangles.push_back({base, base + 1, base + 2});
+  }
+  return mesh;
+}
+
+/// 64 x 48: from z = 3 with fovy 45 deg the view at z = 0 spans +-1.24 up and +-1.66 across.
+SceneFile make_stacked(const std::string& file_name, const std::string& obj) {
+  SceneFile scene{file_name, 64, 48, {0.25, 0.35, 0.5}, {}, {}};
+  scene.camera = {{0.0, 0.0, 3.0}, {0.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, 45.0, 1.0, 5.0};
+  scene.instances.push_back(Instance{obj, Instance::Color::PerTriangle, {}, std::nullopt});
+  return scene;
+}
+
+// ---------------------------------------------------------------------------------------------
 // Output.
 
 struct OutputFile {
@@ -457,10 +1122,15 @@ struct OutputFile {
 };
 
 struct Entry {
-  std::string name;               ///< the JSON (or mesh) file name
-  std::vector<OutputFile> files;  ///< what --only <name> writes
+  std::string name;  ///< the JSON (or mesh) file name
+  /// What --only <name> writes. Built on demand: the real-content meshes take a while.
+  std::function<std::vector<OutputFile>()> files;
 };
 
+OutputFile file(const SceneFile& scene) { return OutputFile{scene.file_name, scene.to_json()}; }
+OutputFile obj(const Mesh& mesh) { return OutputFile{mesh.file_name, mesh.to_obj()}; }
+
+/// The committed set (scenes/).
 std::vector<Entry> all_entries() {
   const Mesh sphere = make_uv_sphere("sphere.obj", 48, 24);
   const Mesh sphere5k = make_uv_sphere("sphere5k.obj", 50, 51);
@@ -468,24 +1138,75 @@ std::vector<Entry> all_entries() {
   const Mesh box = make_box();
   const Mesh big_tri = make_big_tri();
   const Mesh tri = make_tri();
-  const auto file = [](const SceneFile& scene) {
-    return OutputFile{scene.file_name, scene.to_json()};
+  const auto fixed = [](std::vector<OutputFile> files) {
+    return [files = std::move(files)] { return files; };
   };
-  const auto obj = [](const Mesh& mesh) { return OutputFile{mesh.file_name, mesh.to_obj()}; };
   return {
-      {"default.json", {file(make_default()), obj(sphere), obj(fan)}},
-      {"sphere_closed.json", {file(make_sphere_closed()), obj(sphere)}},
-      {"boxes.json", {file(make_boxes()), obj(box)}},
-      {"slivers.json", {file(make_slivers()), obj(fan)}},
-      {"near_plane.json", {file(make_near_plane()), obj(big_tri)}},
-      {"sphere_grid.json", {file(make_sphere_grid()), obj(sphere5k)}},
-      {"overlap.json", {file(make_overlap()), obj(tri)}},
-      {"sphere.obj", {obj(sphere)}},
-      {"sphere5k.obj", {obj(sphere5k)}},
-      {"fan.obj", {obj(fan)}},
-      {"box.obj", {obj(box)}},
-      {"big_tri.obj", {obj(big_tri)}},
-      {"tri.obj", {obj(tri)}},
+      {"default.json", fixed({file(make_default()), obj(sphere), obj(fan)})},
+      {"sphere_closed.json", fixed({file(make_sphere_closed()), obj(sphere)})},
+      {"boxes.json", fixed({file(make_boxes()), obj(box)})},
+      {"slivers.json", fixed({file(make_slivers()), obj(fan)})},
+      {"near_plane.json", fixed({file(make_near_plane()), obj(big_tri)})},
+      {"sphere_grid.json", fixed({file(make_sphere_grid()), obj(sphere5k)})},
+      {"overlap.json", fixed({file(make_overlap()), obj(tri)})},
+      {"sphere.obj", fixed({obj(sphere)})},
+      {"sphere5k.obj", fixed({obj(sphere5k)})},
+      {"fan.obj", fixed({obj(fan)})},
+      {"box.obj", fixed({obj(box)})},
+      {"big_tri.obj", fixed({obj(big_tri)})},
+      {"tri.obj", fixed({obj(tri)})},
+  };
+}
+
+/// The real-content set (--real DIR): scenes only; each writes its JSON and its meshes.
+std::vector<Entry> real_entries() {
+  return {
+      {"folded_sphere.json",
+       [] {
+         return std::vector{file(make_folded_sphere()), obj(make_folded_sphere_mesh())};
+       }},
+      {"pleated_sheet.json",
+       [] {
+         return std::vector{file(make_pleated_sheet()), obj(make_pleated_sheet_mesh())};
+       }},
+      {"torus_knot.json",
+       [] {
+         return std::vector{file(make_torus_knot()), obj(make_torus_knot_mesh())};
+       }},
+      {"interpenetrating.json",
+       [] {
+         Mesh sphere = make_uv_sphere("interpenetrating_sphere.obj", 128, 64);
+         return std::vector{file(make_interpenetrating()), obj(sphere),
+                            obj(make_grid_box("interpenetrating_box.obj", 16))};
+       }},
+      {"open_parts.json",
+       [] {
+         return std::vector{file(make_open_parts()), obj(make_shell_mesh()),
+                            obj(make_uv_sphere("open_parts_eye.obj", 64, 32))};
+       }},
+      {"decals.json",
+       [] {
+         return std::vector{file(make_decals()), obj(make_decals_mesh())};
+       }},
+      {"cad_assembly.json",
+       [] {
+         return std::vector{file(make_cad_assembly()), obj(make_cad_assembly_mesh())};
+       }},
+      {"stacked.json",
+       [] {
+         return std::vector{file(make_stacked("stacked.json", "stacked.obj")),
+                            obj(make_stacked_mesh())};
+       }},
+      {"stacked_offset.json",
+       [] {
+         return std::vector{file(make_stacked("stacked_offset.json", "stacked_offset.obj")),
+                            obj(make_stacked_offset_mesh())};
+       }},
+      {"sphere_grid_per_triangle.json",
+       [] {
+         return std::vector{file(make_sphere_grid("sphere_grid_per_triangle.json", true)),
+                            obj(make_uv_sphere("sphere5k.obj", 50, 51))};
+       }},
   };
 }
 
@@ -498,13 +1219,21 @@ int run(int argc, char** argv) {
   CLI::App app{
       "covrast-scenegen: writes the covrast test scenes (JSON + OBJ) into OUT_DIR, byte for "
       "byte the same on every run. Scenes: default, sphere_closed, boxes, slivers, near_plane, "
-      "sphere_grid, overlap (each with the meshes it uses)."};
+      "sphere_grid, overlap (each with the meshes it uses). With --real DIR instead, writes the "
+      "real-content set (not committed): folded_sphere, pleated_sheet, torus_knot, "
+      "interpenetrating, open_parts, decals, cad_assembly, stacked, stacked_offset, "
+      "sphere_grid_per_triangle."};
   std::string out_dir;
+  std::string real_dir;
   std::vector<std::string> only;
-  app.add_option("OUT_DIR", out_dir, "directory to write into (created if missing)")->required();
+  app.add_option("OUT_DIR", out_dir,
+                 "directory to write the committed scenes into (created if missing)");
+  app.add_option("--real", real_dir,
+                 "write the real-content scenes into this directory (created if missing) "
+                 "instead of the committed ones into OUT_DIR");
   app.add_option("--only", only,
-                 "write only this scene (with its meshes) or mesh, e.g. boxes or sphere5k.obj; "
-                 "repeatable")
+                 "write only this scene (with its meshes) or mesh, e.g. boxes or sphere5k.obj "
+                 "(with --real: a real-content scene, e.g. torus_knot); repeatable")
       ->expected(1)
       ->take_all();
   try {
@@ -512,18 +1241,17 @@ int run(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
   }
+  if (out_dir.empty() == real_dir.empty()) {
+    std::cerr << "covrast-scenegen: give either OUT_DIR (the committed scenes) or --real DIR "
+                 "(the real-content scenes)\n";
+    return 2;
+  }
+  const bool real = !real_dir.empty();
 
-  const std::vector<Entry> entries = all_entries();
-  std::vector<const OutputFile*> to_write;
-  const auto add = [&to_write](const Entry& entry) {
-    for (const OutputFile& f : entry.files) {
-      const bool seen = std::any_of(to_write.begin(), to_write.end(),
-                                    [&f](const OutputFile* w) { return w->name == f.name; });
-      if (!seen) to_write.push_back(&f);
-    }
-  };
+  const std::vector<Entry> entries = real ? real_entries() : all_entries();
+  std::vector<const Entry*> selected;
   if (only.empty()) {
-    for (const Entry& entry : entries) add(entry);
+    for (const Entry& entry : entries) selected.push_back(&entry);
   } else {
     for (const std::string& requested : only) {
       const auto it = std::find_if(entries.begin(), entries.end(), [&requested](const Entry& e) {
@@ -532,15 +1260,23 @@ int run(int argc, char** argv) {
       if (it == entries.end()) {
         std::string names;
         for (const Entry& e : entries) names += (names.empty() ? "" : ", ") + e.name;
-        std::cerr << "covrast-scenegen: --only: unknown scene or mesh '" << requested
-                  << "' (known: " << names << ")\n";
+        std::cerr << "covrast-scenegen: --only: unknown " << (real ? "real-content " : "")
+                  << "scene or mesh '" << requested << "' (known: " << names << ")\n";
         return 2;
       }
-      add(*it);
+      selected.push_back(&*it);
+    }
+  }
+  std::vector<OutputFile> to_write;
+  for (const Entry* entry : selected) {
+    for (OutputFile& f : entry->files()) {
+      const bool seen = std::any_of(to_write.begin(), to_write.end(),
+                                    [&f](const OutputFile& w) { return w.name == f.name; });
+      if (!seen) to_write.push_back(std::move(f));
     }
   }
 
-  const std::filesystem::path dir(out_dir);
+  const std::filesystem::path dir(real ? real_dir : out_dir);
   std::error_code error;
   std::filesystem::create_directories(dir, error);
   if (error) {
@@ -548,11 +1284,11 @@ int run(int argc, char** argv) {
               << ": cannot create directory: " << error.message() << "\n";
     return 1;
   }
-  for (const OutputFile* f : to_write) {
-    const std::filesystem::path path = dir / f->name;
+  for (const OutputFile& f : to_write) {
+    const std::filesystem::path path = dir / f.name;
     // Binary mode: "\n" line ends on every platform, so the bytes match the committed files.
     std::ofstream stream(path, std::ios::binary | std::ios::trunc);
-    stream.write(f->text.data(), static_cast<std::streamsize>(f->text.size()));
+    stream.write(f.text.data(), static_cast<std::streamsize>(f.text.size()));
     stream.close();
     if (!stream) {
       std::cerr << "covrast-scenegen: " << path.string() << ": cannot write file\n";
