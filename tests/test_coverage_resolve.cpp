@@ -453,6 +453,8 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
 /// to about 0.018). In 8-bit sRGB the same error reads large in dark channels (0.02 linear is
 /// 39 codes at 0), so the 8-bit measure is reported, and bounded only on average.
 constexpr double kMaskToleranceLinear = 1.0 / 32.0;
+/// The same for pixels that overflowed into 256 depth-tested samples (abuffer.hpp).
+constexpr double kSampledToleranceLinear = 1.0 / 16.0;
 
 /// A UV sphere (24 x 48) of radius 3 at (0.1, 0.05, 0), 128 x 96 pixels.
 Scene sphere_scene(glm::vec3 color, glm::vec3 background) {
@@ -618,7 +620,9 @@ TEST_CASE("coverage mode: more fragments than a pixel list holds keep their plac
                    << encode8(r.g) << ", " << encode8(r.b) << "); fragment overflows "
                    << result.stats.fragment_overflows);
     CHECK(result.stats.fragment_overflows > 0);
-    CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+    // A pixel whose list overflows while its fragments are not one disjoint set resolves
+    // from its 16 x 16 samples, where a straight edge can misplace up to 1/16 of a pixel.
+    CHECK(c.max_diff_linear <= kSampledToleranceLinear);
   }
 }
 

@@ -167,11 +167,7 @@ TEST_CASE("covrast-scenegen --real writes the set, the same bytes every run", "[
   CHECK(fs::is_empty(refused.path()));
 }
 
-// Known failure, issue "Coverage mode on real meshes" (open): measured on this commit, see
-// the tag's message. [!shouldfail] keeps it visible in every run and turns it into a failure
-// the day the coverage mode meets the bound, so that the tag is removed then.
-TEST_CASE("real-content folded_sphere: coverage closer to the reference than ssaa:16",
-          "[real][!shouldfail]") {
+TEST_CASE("real-content folded_sphere: coverage closer to the reference than ssaa:16", "[real]") {
   check_real_scene("folded_sphere", 160, 90);
 }
 
@@ -215,11 +211,7 @@ TEST_CASE("real-content stacked: coverage closer to the reference than ssaa:16",
   check_real_scene("stacked", 32, 24);
 }
 
-// Known failure, issue "Coverage mode on real meshes" (open): measured on this commit, see
-// the tag's message. [!shouldfail] keeps it visible in every run and turns it into a failure
-// the day the coverage mode meets the bound, so that the tag is removed then.
-TEST_CASE("real-content stacked_offset: coverage closer to the reference than ssaa:16",
-          "[real][!shouldfail]") {
+TEST_CASE("real-content stacked_offset: coverage closer to the reference than ssaa:16", "[real]") {
   check_real_scene("stacked_offset", 32, 24);
 }
 

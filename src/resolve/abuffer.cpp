@@ -74,13 +74,9 @@ DepthRange range_around(const TriangleSetup& t, double centre_z) {
   return DepthRange{centre_z - reach, centre_z + reach};
 }
 
-DepthRange pixel_depth_range(const TriangleSetup& t, int x, int y) {
-  return range_around(t, t.depth_at(x + 0.5, y + 0.5));
-}
-
 /// Whether two fragments are pieces of one layer of a surface: same mesh instance and facing,
 /// and sharing a vertex; a merged fragment stands for several adjacent pieces (merges keep to
-/// one layer, see handle_overflow), so it joins any fragment of its surface that overlaps it
+/// the open set, see merge_into_open_set), so it joins any fragment of its surface that overlaps it
 /// in depth.
 bool layer_neighbours(const TriangleSetup& a, bool a_merged, DepthRange ra, const TriangleSetup& b,
                       bool b_merged, DepthRange rb) {
@@ -263,6 +259,7 @@ std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
 ABufferTile::ABufferTile(int tile_px)
     : stride_(tile_px),
       capacity_(g_capacity.load()),
+      mixed_capacity_(std::min(capacity_, kMaxMixedFragments)),
       block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
   const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);
   block_uniform_.resize(blocks);
@@ -292,6 +289,7 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   pool_.clear();
   merged_slot_.clear();
   merged_.clear();
+  samples_.clear();
 }
 
 /// A layer in front of everything else: colour = (sum coverage_i colour_i) / max(sum
@@ -415,29 +413,24 @@ bool ABufferTile::add_covering_tile(const TriangleSetup& t, const PixelRect& r) 
   return order != 0;
 }
 
-void ABufferTile::merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask,
-                             glm::vec3 color, int x, int y, const TriangleSetup* const* pieces,
-                             int piece_count) {
+void ABufferTile::merge_into(std::uint32_t f, const TriangleSetup& t, std::uint32_t coverage, int x,
+                             int y) {
   Fragment& fragment = pool_[f];
   if (!(fragment.coverage & kMergedFlag)) {
     if (merged_slot_.size() < pool_.size()) merged_slot_.resize(pool_.size(), kEnd);
     merged_slot_[f] = std::uint32_t(merged_.size());
-    MergedPiece first{pixel_sample_mask(*fragment.triangle, x, y),
-                      shade(*fragment.triangle, x + 0.5, y + 0.5, true),
-                      fragment.coverage & kCoverageBits,
-                      1,
-                      {fragment.triangle}};
-    merged_.push_back(first);
+    const std::uint32_t own = fragment.coverage & kCoverageBits;
+    merged_.push_back(MergedPiece{pixel_sample_mask(*fragment.triangle, x, y),
+                                  shade(*fragment.triangle, x + 0.5, y + 0.5, true),
+                                  own,
+                                  1,
+                                  {fragment.triangle}});
   }
   MergedPiece& m = merged_[merged_slot_[f]];
-  m.mask |= mask;
-  if (m.pieces != kUnknownPieces && piece_count >= 0 &&
-      m.pieces + piece_count <= kMaxMergedPieces) {
-    for (int k = 0; k < piece_count; ++k) m.piece[m.pieces++] = pieces[k];
-  } else {
-    m.pieces = kUnknownPieces;
-  }
+  m.mask |= pixel_sample_mask(t, x, y);
+  m.piece[m.pieces++] = &t;
   // Running coverage-weighted mean of the pieces' colours.
+  const glm::vec3 color = shade(t, x + 0.5, y + 0.5, true);
   const std::uint32_t weight = m.weight + coverage;
   if (weight > 0) {
     m.color = (m.color * float(m.weight) + color * float(coverage)) / float(weight);
@@ -458,7 +451,7 @@ bool ABufferTile::merge_into_open_set(std::size_t pixel, int x, int y, const Tri
     if (!(pool_[f].coverage & kOpenFlag)) continue;
     const TriangleSetup* const* pieces;
     const int count = fragment_pieces(f, pieces);
-    if (count < 0 || count >= kMaxMergedPieces) continue;
+    if (count >= kMaxMergedPieces) continue;
     const int rank = share_vertex(*pool_[f].triangle, t) ? count : count + kMaxMergedPieces;
     if (rank < best) {
       best = rank;
@@ -466,145 +459,9 @@ bool ABufferTile::merge_into_open_set(std::size_t pixel, int x, int y, const Tri
     }
   }
   if (into == kEnd) return false;
-  const TriangleSetup* piece = &t;
-  merge_into(into, coverage, pixel_sample_mask(t, x, y), shade(t, x + 0.5, y + 0.5, true), x, y,
-             &piece, 1);
+  merge_into(into, t, coverage, x, y);
   add_to_sums(pixel, x, y, t, coverage, centre_z);
   if (layer_sums_[pixel].coverage >= std::uint32_t(kCoverageOne)) complete_open_set(pixel, x, y);
-  return true;
-}
-
-bool ABufferTile::handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                                  std::uint32_t coverage) {
-  ++overflows_;
-  // Steps 1 and 2 look for fragments to drop in O(n^2); what they find changes only as new
-  // pieces arrive, so a pixel that keeps overflowing retries them every kDropRetry-th time
-  // (its open_count_ counts the overflows: an overflowed pixel keeps no sets), and merges
-  // in O(n) in between.
-  constexpr int kDropRetry = 16;
-  const bool try_drops = open_count_[pixel]++ % kDropRetry == 0;
-  std::uint32_t id[kMaxFragmentsPerPixel];
-  DepthRange range[kMaxFragmentsPerPixel];
-  std::uint32_t cov[kMaxFragmentsPerPixel];
-  bool keep[kMaxFragmentsPerPixel];
-  int n = 0;
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next, ++n) {
-    id[n] = f;
-    range[n] = pixel_depth_range(*pool_[f].triangle, x, y);
-    cov[n] = pool_[f].coverage & kCoverageBits;
-    keep[n] = true;
-  }
-  auto tri = [&](int i) -> const TriangleSetup& { return *pool_[id[i]].triangle; };
-  auto merged = [&](int i) { return (pool_[id[i]].coverage & kMergedFlag) != 0; };
-  // 1. Drop fragments that the opaque surface hides everywhere.
-  if (const TriangleSetup* opaque = opaque_[pixel]; try_drops && opaque != nullptr) {
-    for (int i = 0; i < n; ++i) keep[i] = order_of(tri(i), *opaque, x, y) != DepthOrder::Behind;
-  }
-  // 2. Drop fragments wholly behind a layer that fills the pixel: the nearest fragment's
-  //    connected pieces of one surface (as in resolve_pixel), when their areas add to one.
-  bool in_layer[kMaxFragmentsPerPixel];
-  const FrontLayer layer = !try_drops ? FrontLayer{0, 0, 0.0}
-                                      : find_front_layer(
-                                            n, range, cov, keep,
-                                            [&](int i, int j) {
-                                              return layer_neighbours(tri(i), merged(i), range[i],
-                                                                      tri(j), merged(j), range[j]);
-                                            },
-                                            in_layer);
-  FragmentPieces pieces[kMaxFragmentsPerPixel];
-  for (int i = 0; i < n; ++i) pieces[i].count = fragment_pieces(id[i], pieces[i].piece);
-  if (layer.members > 0 && layer.coverage >= std::uint32_t(kCoverageOne) &&
-      pieces_disjoint(n, pieces, in_layer)) {
-    for (int i = 0; i < n; ++i) {
-      if (keep[i] && !in_layer[i] && range[i].min > layer.max_depth) keep[i] = false;
-    }
-  }
-  int kept = 0;
-  for (int i = 0; i < n; ++i) kept += keep[i];
-  if (kept < n) {
-    std::uint32_t last = kEnd;
-    head_[pixel] = kEnd;
-    for (int i = 0; i < n; ++i) {
-      if (!keep[i]) continue;
-      if (last == kEnd) {
-        head_[pixel] = id[i];
-      } else {
-        pool_[last].next = id[i];
-      }
-      last = id[i];
-    }
-    if (last != kEnd) pool_[last].next = kEnd;
-    tail_[pixel] = last;
-    count_[pixel] = std::uint8_t(kept);
-    if (kept < capacity_) return false;
-  }
-  // 3. Merge the new fragment into a fragment of its surface and facing: one sharing a vertex
-  //    with it, else the one nearest in depth (pieces of one layer, not of a fold behind).
-  const DepthRange new_range = pixel_depth_range(*t, x, y);
-  auto gap = [](DepthRange a, DepthRange b) {
-    return std::max(0.0, std::max(a.min, b.min) - std::min(a.max, b.max));
-  };
-  int into = -1;
-  double best_gap = 0.0;
-  for (int i = 0; i < n; ++i) {
-    if (!same_surface(tri(i), *t)) continue;
-    const double g = share_vertex(tri(i), *t) ? -1.0 : gap(range[i], new_range);
-    if (into < 0 || g < best_gap) {
-      into = i;
-      best_gap = g;
-    }
-  }
-  if (into >= 0) {
-    merge_into(id[into], coverage, pixel_sample_mask(*t, x, y), shade(*t, x + 0.5, y + 0.5, true),
-               x, y, &t, 1);
-    return true;
-  }
-  // 4. Merge two fragments of one surface and facing already in the list, freeing a slot:
-  //    a pair sharing a vertex, else the pair nearest in depth.
-  int keep_i = -1, drop_j = -1;
-  best_gap = 0.0;
-  for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) {
-      if (!same_surface(tri(i), tri(j))) continue;
-      const double g = share_vertex(tri(i), tri(j)) ? -1.0 : gap(range[i], range[j]);
-      if (keep_i < 0 || g < best_gap) {
-        keep_i = i;
-        drop_j = j;
-        best_gap = g;
-      }
-    }
-  }
-  if (keep_i >= 0) {
-    const Fragment victim = pool_[id[drop_j]];
-    if (victim.coverage & kMergedFlag) {
-      const MergedPiece piece = merged_piece(id[drop_j]);  // a copy: merge_into may grow merged_
-      merge_into(id[keep_i], piece.weight, piece.mask, piece.color, x, y, piece.piece,
-                 piece.pieces == kUnknownPieces ? -1 : piece.pieces);
-    } else {
-      merge_into(id[keep_i], victim.coverage & kCoverageBits,
-                 pixel_sample_mask(*victim.triangle, x, y),
-                 shade(*victim.triangle, x + 0.5, y + 0.5, true), x, y, &victim.triangle, 1);
-    }
-    // Unlink the victim.
-    const std::uint32_t prev = drop_j > 0 ? id[drop_j - 1] : kEnd;
-    if (prev == kEnd) {
-      head_[pixel] = victim.next;
-    } else {
-      pool_[prev].next = victim.next;
-    }
-    if (tail_[pixel] == id[drop_j]) tail_[pixel] = prev;
-    --count_[pixel];
-    return false;
-  }
-  // 5. Many different surfaces in one pixel: keep the larger areas.
-  int smallest = 0;
-  for (int i = 1; i < n; ++i) {
-    if (cov[i] < cov[smallest]) smallest = i;
-  }
-  if (coverage > cov[smallest]) {
-    pool_[id[smallest]].triangle = t;
-    pool_[id[smallest]].coverage = coverage;
-  }
   return true;
 }
 
@@ -688,22 +545,18 @@ void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
 
 bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                     std::uint32_t coverage, double centre_z) {
-  if (layer_[pixel] != Layer::Overflowed && open_count_[pixel] != 0 && joins_open_set(pixel, *t) &&
-      merge_into_open_set(pixel, x, y, *t, coverage, centre_z)) {
-    ++overflows_;
+  ++overflows_;
+  if (layer_[pixel] == Layer::Sampled) {
+    add_to_samples(pixel, x, y, *t);
     return true;
   }
-  if (layer_[pixel] != Layer::Overflowed) {
-    // Merges and drops: only the list knows. The occluder depth stays valid (what covered
-    // the pixel still does).
-    layer_[pixel] = Layer::Overflowed;
-    open_count_[pixel] = 0;
-    closed_count_[pixel] = 0;
-    for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-      pool_[f].coverage &= kMergedFlag | kCoverageBits;
-    }
+  if (open_count_[pixel] != 0 && joins_open_set(pixel, *t) &&
+      merge_into_open_set(pixel, x, y, *t, coverage, centre_z)) {
+    return true;
   }
-  return handle_overflow(pixel, x, y, t, coverage);
+  to_samples(pixel, x, y);
+  add_to_samples(pixel, x, y, *t);
+  return true;
 }
 
 glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
@@ -943,6 +796,85 @@ void ABufferTile::unhidden_fragments(int x, int y, const TriangleSetup* opaque, 
   }
 }
 
+void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
+  const std::uint32_t slot = std::uint32_t(samples_.size());
+  samples_.emplace_back();
+  PixelSamples& samples = samples_.back();
+  const TriangleSetup* opaque = opaque_[pixel];
+  if (opaque != nullptr) {
+    const SamplePlane plane(*opaque, x, y);
+    for (int j = 0; j < kMaskGridSide; ++j) {
+      const double row_z = plane.row(j);
+      for (int i = 0; i < kMaskGridSide; ++i) samples.z[j * kMaskGridSide + i] = plane.at(row_z, i);
+    }
+  } else {
+    std::fill(samples.z, samples.z + kMaskSamples, kFar);
+  }
+  std::fill(samples.winner, samples.winner + kMaskSamples, opaque);
+  // The stored fragments, in list order (merged ones by their pieces, which they always know:
+  // merges happen only inside the open set), then the list is gone.
+  const std::uint32_t head = head_[pixel];
+  layer_[pixel] = Layer::Sampled;
+  tail_[pixel] = slot;
+  count_[pixel] = std::uint8_t(kMaxFragmentsPerPixel);  // every later fragment comes here
+  for (std::uint32_t f = head; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kMergedFlag)) {
+      add_to_samples(pixel, x, y, *pool_[f].triangle);
+      continue;
+    }
+    const MergedPiece& m = merged_piece(f);  // an open-set member: its pieces, one by one
+    for (int k = 0; k < m.pieces; ++k) add_to_samples(pixel, x, y, *m.piece[k]);
+  }
+  head_[pixel] = kEnd;
+  open_count_[pixel] = closed_count_[pixel] = 0;
+}
+
+void ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t) {
+  PixelSamples& samples = samples_[tail_[pixel]];
+  const SampleMask mask = pixel_sample_mask(t, x, y);
+  const SamplePlane plane(t, x, y);
+  for (int j = 0; j < kMaskGridSide; ++j) {
+    std::uint32_t bits = mask.row(j);
+    if (bits == 0) continue;
+    const double row_z = plane.row(j);
+    for (; bits != 0; bits &= bits - 1) {
+      const int s = j * kMaskGridSide + std::countr_zero(bits);
+      const double z = plane.at(row_z, std::countr_zero(bits));
+      const TriangleSetup* w = samples.winner[s];
+      // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
+      if (z < samples.z[s] || (z == samples.z[s] && w != nullptr && t.primitive < w->primitive)) {
+        samples.z[s] = z;
+        samples.winner[s] = &t;
+      }
+    }
+  }
+}
+
+glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,
+                                       float& depth) {
+  // The mean of the samples' colours, as 256-sample MSAA would give: the samples of a
+  // tessellation's pieces add up to the whole pixel exactly, so no background leaks, which
+  // weighting each winner by its exact area times its share of won samples cannot promise
+  // (a piece too thin to own a sample would drop out).
+  const PixelSamples& samples = samples_[tail_[pixel]];
+  double r = 0, g = 0, b = 0;
+  const TriangleSetup* last = nullptr;
+  glm::vec3 c = background;
+  depth = std::numeric_limits<float>::infinity();
+  for (int s = 0; s < kMaskSamples; ++s) {
+    const TriangleSetup* w = samples.winner[s];
+    if (w != last) {  // winners come in runs: shade each run once
+      last = w;
+      c = w != nullptr ? shade(*w, x + 0.5, y + 0.5, true) : background;
+    }
+    if (w != nullptr) depth = std::min(depth, float(samples.z[s]));
+    r += c.r;
+    g += c.g;
+    b += c.b;
+  }
+  return glm::vec3(float(r / kMaskSamples), float(g / kMaskSamples), float(b / kMaskSamples));
+}
+
 void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
                                        const FrameTarget& target) {
   if (opaque == nullptr || opaque->flat_color) {
@@ -1005,6 +937,10 @@ void ABufferTile::resolve(const FrameTarget& target) {
             ++from_sums;
             continue;
           }
+          if (layer_[pixel] == Layer::Sampled) {
+            color_[pixel] = resolve_samples(pixel, x, y, target.background_linear, depth_[pixel]);
+            continue;
+          }
           if (head_[pixel] == kEnd) {
             // No fragments: the opaque surface or the background, as resolve_pixel gives it.
             color_[pixel] =
@@ -1025,7 +961,7 @@ std::size_t ABufferTile::scratch_bytes() const {
   return opaque_.size() * (sizeof(void*) + sizeof(double) + 2 * sizeof(std::uint32_t) + 1 +
                            sizeof(glm::vec3) + sizeof(float)) +
          pool_.capacity() * sizeof(Fragment) + merged_slot_.capacity() * sizeof(std::uint32_t) +
-         merged_.capacity() * sizeof(MergedPiece);
+         merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples);
 }
 
 }  // namespace covrast::detail

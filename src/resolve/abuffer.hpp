@@ -47,15 +47,15 @@
 
 namespace covrast::detail {
 
-/// Fragments one pixel keeps (sub-pixel triangles of dense meshes put dozens in a pixel; at
-/// 32 the Stanford bunny at 640x360 overflowed 6,000 times, at 128 never). Beyond it (counted
-/// in overflow_count()): drop fragments the opaque surface hides, and those wholly behind a
-/// layer of one surface that fills the pixel; else merge the new fragment into one of the same
-/// surface and facing, sharing a vertex with it or else nearest in depth (so that a fold behind
-/// is not mixed in): areas add, sample masks are united, the older triangle's plane and colour
-/// stand for both; else merge two such fragments already in the list; only when 128 different
-/// surfaces meet in one pixel is the fragment of least area dropped.
+/// Fragments one pixel keeps while they are one disjoint set (sub-pixel triangles of dense
+/// meshes put dozens in a pixel, up to ~180 at the pole of a UV sphere). Beyond it (counted
+/// in overflow_count()) a fragment that joins the set merges into a member that keeps its
+/// pieces, so the sums stay exact; otherwise the pixel turns into samples (PixelSamples).
 inline constexpr int kMaxFragmentsPerPixel = 128;
+/// Fragments a pixel keeps while they are not one disjoint set: past it, the list resolve
+/// would compare every fragment with every other (O(n^2)), so the pixel turns into 256
+/// depth-tested samples instead, at the cost of MSAA per further fragment.
+inline constexpr int kMaxMixedFragments = 32;
 
 /// Block side [pixels] of the A-buffer's block-level fast path.
 inline constexpr int kAbufferBlockPx = 8;
@@ -142,18 +142,15 @@ class ABufferTile {
   };
   /// What a fragment that stands for several triangles of one surface keeps (overflow only).
   static constexpr int kMaxMergedPieces = 6;
-  static constexpr std::uint8_t kUnknownPieces = 0xff;
   struct MergedPiece {
     SampleMask mask;       ///< 16x16 sample mask: the union of the pieces'
     glm::vec3 color;       ///< coverage-weighted mean colour (linear)
     std::uint32_t weight;  ///< summed coverage behind `color` (unclamped)
-    /// The triangles it stands for, so that overlap tests stay exact (kUnknownPieces: more
-    /// than kMaxMergedPieces; such a fragment proves nothing).
+    /// The triangles it stands for, so that overlap tests stay exact.
     std::uint8_t pieces;
     const TriangleSetup* piece[kMaxMergedPieces];
   };
-  /// The triangles fragment `f` stands for, in `out`: one, a merged fragment's pieces, or
-  /// -1 when they are not known.
+  /// The triangles fragment `f` stands for, in `out`: one, or a merged fragment's pieces.
   int fragment_pieces(std::uint32_t f, const TriangleSetup* const*& out) const {
     if (!(pool_[f].coverage & kMergedFlag)) {
       out = &pool_[f].triangle;
@@ -161,7 +158,7 @@ class ABufferTile {
     }
     const MergedPiece& m = merged_piece(f);
     out = m.piece;
-    return m.pieces == kUnknownPieces ? -1 : m.pieces;
+    return m.pieces;
   }
   static constexpr std::uint32_t kMergedFlag = 0x80000000u;
   static constexpr std::uint32_t kOpenFlag = 0x40000000u;
@@ -183,7 +180,7 @@ class ABufferTile {
   void materialize_block(std::size_t b);
   inline void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                            std::uint32_t coverage, double centre_z);
-  /// The list is full: the overflow policy (handle_overflow); true when `t` was absorbed.
+  /// The list is full: the overflow policy; true when `t` was absorbed (always).
   bool overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                          std::uint32_t coverage, double centre_z);
   /// Whether `t` overlaps no fragment of the pixel's open set (an empty set takes anything).
@@ -203,12 +200,16 @@ class ABufferTile {
   /// Removes the fragments for which `drop(fragment)` holds from the pixel's list.
   template <class Drop>
   void remove_fragments(std::size_t pixel, Drop drop);
-  /// Makes room in a full list, or absorbs the new fragment; true when it was absorbed.
-  bool handle_overflow(std::size_t pixel, int x, int y, const TriangleSetup* t,
-                       std::uint32_t coverage);
-  /// Merges a piece (coverage, sample mask, colour at the pixel centre) into fragment `f`.
-  void merge_into(std::uint32_t f, std::uint32_t coverage, const SampleMask& mask, glm::vec3 color,
-                  int x, int y, const TriangleSetup* const* pieces, int piece_count);
+  /// Turns a pixel's list into 16x16 sub-pixel samples (see PixelSamples) and frees it.
+  void to_samples(std::size_t pixel, int x, int y);
+  /// Draws triangle `t` into a sampled pixel's samples: nearest wins, equal depth keeps the
+  /// earlier triangle.
+  void add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t);
+  /// A sampled pixel's colour: the mean of its samples' winners' colours (and its depth).
+  glm::vec3 resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
+  /// Merges triangle `t`'s piece (coverage, sample mask, colour at the pixel centre) into
+  /// fragment `f`, which has room for another piece.
+  void merge_into(std::uint32_t f, const TriangleSetup& t, std::uint32_t coverage, int x, int y);
   /// Overflow of a pixel, by a fragment that joins its open set: merges it into an open
   /// member, keeping the pieces and the exact sums; false when no member has room for another
   /// piece.
@@ -232,6 +233,7 @@ class ABufferTile {
 
   int stride_;
   int capacity_;  ///< fragments per pixel before the overflow policy, <= kMaxFragmentsPerPixel
+  int mixed_capacity_;  ///< the same for a pixel whose fragments are not one disjoint set
   PixelRect rect_;
   /// While tile_uniform_: every pixel's opaque triangle is uniform_ (null = background), no
   /// pixel has fragments, and neither the blocks' nor the pixels' state is written.
@@ -250,9 +252,9 @@ class ABufferTile {
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
   /// Per pixel: Empty (no fragments), One (every fragment is in the open set, so they are
-  /// pairwise disjoint and layer_sums_ describes them all), Mixed, or Overflowed (the list
+  /// pairwise disjoint and layer_sums_ describes them all), Mixed, or Sampled (the list
   /// has merged or dropped fragments: no sets are kept, only the list knows).
-  enum class Layer : std::uint8_t { Empty, One, Mixed, Overflowed };
+  enum class Layer : std::uint8_t { Empty, One, Mixed, Sampled };
   /// Running sums of the pixel's open set, or of its closed set while that is all there is.
   struct LayerSums {
     std::uint32_t coverage;  ///< sum of the fragments' 8.8 coverage
@@ -272,6 +274,14 @@ class ABufferTile {
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
   std::vector<MergedPiece> merged_;
+  /// A pixel whose list overflowed, as 256 samples at the positions of the sample masks: per
+  /// sample the nearest depth so far and the triangle that has it (null: the background).
+  /// MSAA-like cost per fragment, however many arrive; the pixel's tail_ holds its index.
+  struct PixelSamples {
+    double z[kMaskSamples];
+    const TriangleSetup* winner[kMaskSamples];
+  };
+  std::vector<PixelSamples> samples_;
   std::vector<glm::vec3> color_;  ///< resolved linear colour
   std::vector<float> depth_;      ///< resolved window depth
   std::uint64_t overflows_ = 0;
@@ -306,6 +316,15 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
   if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set
   if (closed_count_[pixel] != 0 && hidden_by_closed_set(pixel, x, y, *t, centre_z)) return;
+  if (layer_[pixel] == Layer::Sampled) {
+    // The opaque surface is in the samples already; a full triangle goes there too.
+    if (opaque_[pixel] != nullptr &&
+        order_against_opaque(*t, centre_z, pixel, x, y) == DepthOrder::Behind) {
+      return;
+    }
+    add_to_samples(pixel, x, y, *t);
+    return;
+  }
   if (opaque_[pixel] == nullptr) {
     if (coverage == std::uint32_t(kCoverageOne)) {
       opaque_[pixel] = t;
@@ -333,9 +352,13 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
 
 inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                                       std::uint32_t coverage, double centre_z) {
-  if (count_[pixel] >= capacity_ && overflow_fragment(pixel, x, y, t, coverage, centre_z)) return;
+  // Sampled pixels, and lists at their limit: the overflow policy.
+  if (count_[pixel] >= (layer_[pixel] == Layer::One ? capacity_ : mixed_capacity_) &&
+      overflow_fragment(pixel, x, y, t, coverage, centre_z)) {
+    return;
+  }
   std::uint32_t flags = 0;
-  if (layer_[pixel] != Layer::Overflowed && joins_open_set(pixel, *t)) {
+  if (joins_open_set(pixel, *t)) {
     flags = kOpenFlag;
     add_to_sums(pixel, x, y, *t, coverage, centre_z);
   } else if (hidden_by_container(pixel, x, y, *t)) {
@@ -350,7 +373,6 @@ inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const Tri
   }
   tail_[pixel] = index;
   ++count_[pixel];
-  if (layer_[pixel] == Layer::Overflowed) return;
   if (flags == 0) {
     layer_[pixel] = Layer::Mixed;
     return;
