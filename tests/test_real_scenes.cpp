@@ -197,11 +197,7 @@ TEST_CASE("real-content decals: coverage closer to the reference than ssaa:16", 
 }
 
 // 128x72: at 160x90 the reference alone takes about 12 s here (long thin triangles).
-// Known failure, issue "Coverage mode on real meshes" (open): measured on this commit, see
-// the tag's message. [!shouldfail] keeps it visible in every run and turns it into a failure
-// the day the coverage mode meets the bound, so that the tag is removed then.
-TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16",
-          "[real][!shouldfail]") {
+TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16", "[real]") {
   check_real_scene("cad_assembly", 128, 72);
 }
 

@@ -503,12 +503,12 @@ bool ABufferTile::hidden_by_closed_set(std::size_t pixel, int x, int y, const Tr
 
 bool ABufferTile::hidden_by_container(std::size_t pixel, int x, int y,
                                       const TriangleSetup& t) const {
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    if (pool_[f].coverage & kMergedFlag) continue;
-    const TriangleSetup& m = *pool_[f].triangle;
-    if (contains_triangle(m, t) && order_of(t, m, x, y) == DepthOrder::Behind) return true;
-  }
-  return false;
+  // Copies of one triangle arrive one after the other (one mesh, or instances in order), so
+  // the newest fragment is the one to test: O(1) per fragment, not a walk of the list.
+  const std::uint32_t f = tail_[pixel];
+  if (head_[pixel] == kEnd || (pool_[f].coverage & kMergedFlag)) return false;
+  const TriangleSetup& m = *pool_[f].triangle;
+  return contains_triangle(m, t) && order_of(t, m, x, y) == DepthOrder::Behind;
 }
 
 void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {

@@ -194,8 +194,9 @@ class ABufferTile {
   /// Whether the pixel's closed set hides `t` everywhere in the pixel (see closed sets).
   bool hidden_by_closed_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
                             double centre_z) const;
-  /// Whether a stored single-triangle fragment contains `t` and is nearer than or level with
-  /// it all over the pixel (so t, being later, shows nowhere): many copies of one triangle.
+  /// Whether the newest stored fragment is a single triangle that contains `t` and is nearer
+  /// than or level with it all over the pixel (so t, being later, shows nowhere): many copies
+  /// of one triangle.
   bool hidden_by_container(std::size_t pixel, int x, int y, const TriangleSetup& t) const;
   /// Removes the fragments for which `drop(fragment)` holds from the pixel's list.
   template <class Drop>

@@ -36,26 +36,55 @@ inline bool separated_by_edge_of(const TriangleSetup& a, const TriangleSetup& b)
   return false;
 }
 
-/// Whether `b` runs along an edge of `a` in the opposite direction (a -> b in a, b -> a in
-/// b): then the two lie on opposite sides of that edge's line, as neighbours in a
-/// consistently oriented tessellation do, and are disjoint. The cheap common case, first.
-inline bool share_edge_reversed(const TriangleSetup& a, const TriangleSetup& b) {
-  for (int i = 0; i < 3; ++i) {
-    const int i1 = i == 2 ? 0 : i + 1;
-    for (int k = 0; k < 3; ++k) {
-      const int k1 = k == 2 ? 0 : k + 1;
-      if (a.x_fx8[i] == b.x_fx8[k1] && a.y_fx8[i] == b.y_fx8[k1] && a.x_fx8[i1] == b.x_fx8[k] &&
-          a.y_fx8[i1] == b.y_fx8[k]) {
-        return true;
-      }
-    }
+/// Whether the edge i -> j of `a` has the vertices of `b` other than `skip` (-1: none) on
+/// its closed outer side.
+inline bool edge_separates(const TriangleSetup& a, int i, const TriangleSetup& b, int skip) {
+  const int j = i == 2 ? 0 : i + 1;
+  const std::int64_t xi = a.x_fx8[i], yi = a.y_fx8[i];
+  const std::int64_t dx = a.x_fx8[j] - xi, dy = a.y_fx8[j] - yi;
+  bool outside = true;
+  for (int k = 0; k < 3; ++k) {
+    if (k != skip) outside &= dx * (b.y_fx8[k] - yi) - dy * (b.x_fx8[k] - xi) <= 0;
   }
-  return false;
+  return outside;
 }
 
 /// Whether the interiors of `a` and `b` are disjoint (their overlap has zero area).
+///  - Sharing an edge (both its vertices): disjoint exactly when the edge runs the other way
+///    in b, i.e. the two lie on its opposite sides (with both oriented alike, the same way
+///    means the same side, and they overlap along it).
+///  - Sharing one vertex v: a separating line must pass through v, so it is the line of an
+///    edge at v; only those four edges, against the other two vertices, need testing.
+///  - Otherwise all six edges.
 inline bool interiors_disjoint(const TriangleSetup& a, const TriangleSetup& b) {
-  return share_edge_reversed(a, b) || separated_by_edge_of(a, b) || separated_by_edge_of(b, a);
+  int shared = 0, ia = -1, ib = -1, ia2 = -1, ib2 = -1;
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < 3; ++k) {
+      if (a.x_fx8[i] == b.x_fx8[k] && a.y_fx8[i] == b.y_fx8[k]) {
+        ++shared;
+        if (ia < 0) {
+          ia = i;
+          ib = k;
+        } else {
+          ia2 = i;
+          ib2 = k;
+        }
+      }
+    }
+  }
+  if (shared >= 2) {
+    if (shared > 2) return false;  // the same triangle
+    // a's edge ia -> ia2 or ia2 -> ia; reversed in b when b's order of the two is the other.
+    const bool a_forward = ia2 == (ia == 2 ? 0 : ia + 1);  // ia -> ia2 is an edge of a
+    const bool b_forward = ib2 == (ib == 2 ? 0 : ib + 1);  // ib -> ib2 is an edge of b
+    return a_forward != b_forward;
+  }
+  if (shared == 1) {
+    const int a_prev = ia == 0 ? 2 : ia - 1, b_prev = ib == 0 ? 2 : ib - 1;
+    return edge_separates(a, ia, b, ib) || edge_separates(a, a_prev, b, ib) ||
+           edge_separates(b, ib, a, ia) || edge_separates(b, b_prev, a, ia);
+  }
+  return separated_by_edge_of(a, b) || separated_by_edge_of(b, a);
 }
 
 /// Whether `inner` lies inside or on the edges of `outer` (so inner is a subset of outer).
