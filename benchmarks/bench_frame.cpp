@@ -4,7 +4,19 @@
 //
 //   frame/<scene>/<mode>                    bundled scenes at their own size, all threads
 //   frame/<scene>/<mode>/threads:<n>        thread scaling on sphere_grid
-//   frame/model:<file>/<mode>               every OBJ in ../shared/models, framed by its box
+//   frame/real:<name>/<mode>                the scenes `covrast-scenegen --real DIR` writes
+//   frame/model:<name>/<mode>               the sample models of ../shared/models, framed by
+//                                           their box: every OBJ (<name> = file stem) and every
+//                                           glTF model folder gltf/<name>/
+//
+// Options besides Google Benchmark's (which come first, e.g. --benchmark_filter=model:Duck):
+//   --size=WxH        frame size of the real and model scenes (default: real scenes their
+//                     own size, models 1920x1080)
+//   --scenegen=PATH   the covrast-scenegen to ask for the real scenes (default: the one built
+//                     with this executable)
+// The real scenes are written into a temporary directory at start-up when the generator
+// supports --real (exit status 0 and at least one JSON file); otherwise they are skipped with
+// a note on stderr. Models that fail to load or have no triangles report an error.
 //
 // Modes that this build cannot construct yet (msaa, ssaa while they are being written) are
 // not registered. Counters: triangles/s and pixels/s per frame, plus samples/s for the
@@ -15,16 +27,24 @@
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
+#include <stdexcept>
 #include <string>
 #include <thread>
+#include <utility>
 #include <vector>
+
+#include <sys/wait.h>
 
 namespace {
 
@@ -102,19 +122,23 @@ void run_frames(benchmark::State& state, const covrast::Scene& scene,
   }
 }
 
-/// A scene showing one mesh: camera on +z looking at the centre of its bounding box, far
-/// enough for the bounding sphere to fit the vertical field of view.
-covrast::Scene framed_model_scene(const fs::path& path) {
+/// Frame size of the real and model scenes when given (--size=WxH).
+struct ContentSize {
+  int width = 0;
+  int height = 0;
+};
+
+/// A scene showing one mesh with per-triangle colours: camera on +z looking at the centre of
+/// the bounding box of the vertices its triangles use, far enough for the bounding sphere to
+/// fit the vertical field of view (the same framing as benchmarks/report.py).
+covrast::Scene framed_model_scene(const fs::path& path, ContentSize size) {
   covrast::Scene scene;
-  scene.width = 1920;
-  scene.height = 1080;
+  scene.width = size.width > 0 ? size.width : 1920;
+  scene.height = size.height > 0 ? size.height : 1080;
   scene.background_linear = glm::vec3(0.02f);
   std::shared_ptr<covrast::MeshData> mesh = covrast::load_mesh(path);
-  glm::dvec3 lo(1e300), hi(-1e300);
-  for (const glm::vec3& p : mesh->positions) {
-    lo = glm::min(lo, glm::dvec3(p));
-    hi = glm::max(hi, glm::dvec3(p));
-  }
+  if (mesh->triangle_count() == 0) throw std::runtime_error(path.string() + ": no triangles");
+  const glm::dvec3 lo(mesh->bounds_min), hi(mesh->bounds_max);
   const glm::dvec3 centre = 0.5 * (lo + hi);
   const double radius = std::max(0.5 * glm::length(hi - lo), 1e-6);
   const double half_fovy = glm::radians(scene.camera.fovy_deg) / 2;
@@ -128,6 +152,133 @@ covrast::Scene framed_model_scene(const fs::path& path) {
   instance.color_source = covrast::ColorSource::PerTriangle;
   scene.meshes.push_back(std::move(instance));
   return scene;
+}
+
+/// A scene file, at `size` when one is given.
+covrast::Scene sized_scene(const fs::path& path, ContentSize size) {
+  covrast::Scene scene = covrast::load_scene(path);
+  if (size.width > 0) {
+    scene.width = size.width;
+    scene.height = size.height;
+  }
+  return scene;
+}
+
+/// A sample model: its benchmark name and mesh file.
+struct Model {
+  std::string name;
+  fs::path file;
+};
+
+/// The name with every character other than a letter, digit, '_', '.' or '-' replaced by
+/// '_' (as report.py does: "Box With Spaces" -> "Box_With_Spaces").
+std::string safe_name(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      c == '_' || c == '.' || c == '-';
+    if (keep) {
+      out += c;
+    } else if (out.empty() || out.back() != '_') {
+      out += '_';
+    }
+  }
+  return out;
+}
+
+/// The files of `dir` with extension `ext`, sorted; empty when `dir` is not a directory.
+std::vector<fs::path> files_with_extension(const fs::path& dir, const std::string& ext) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) return files;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ext) files.push_back(entry.path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+/// The sample models in `dir`: every OBJ file, then one file per folder of dir/gltf, the first
+/// of glTF-Binary/*.glb, glTF/*.gltf, glTF-Embedded/*.gltf, glTF-Quantized/*.gltf (as
+/// benchmarks/report.py picks them; Draco files are never used).
+std::vector<Model> find_models(const fs::path& dir) {
+  std::vector<Model> models;
+  for (const fs::path& obj : files_with_extension(dir, ".obj")) {
+    models.push_back({safe_name(obj.stem().string()), obj});
+  }
+  std::vector<fs::path> folders;
+  std::error_code ec;
+  if (fs::is_directory(dir / "gltf", ec)) {
+    for (const auto& entry : fs::directory_iterator(dir / "gltf", ec)) {
+      if (entry.is_directory(ec)) folders.push_back(entry.path());
+    }
+  }
+  std::sort(folders.begin(), folders.end());
+  const std::pair<const char*, const char*> variants[] = {{"glTF-Binary", ".glb"},
+                                                          {"glTF", ".gltf"},
+                                                          {"glTF-Embedded", ".gltf"},
+                                                          {"glTF-Quantized", ".gltf"}};
+  for (const fs::path& folder : folders) {
+    std::string name = safe_name(folder.filename().string());
+    if (std::any_of(models.begin(), models.end(),
+                    [&name](const Model& m) { return m.name == name; })) {
+      name += "_gltf";  // an OBJ model of the same name came first
+    }
+    std::optional<fs::path> file;
+    for (const auto& [variant, ext] : variants) {
+      const std::vector<fs::path> files = files_with_extension(folder / variant, ext);
+      if (!files.empty()) {
+        file = files.front();
+        break;
+      }
+    }
+    if (file) {
+      models.push_back({name, *file});
+    } else {
+      std::fprintf(stderr, "bench_frame: model %s: no glTF-Binary/*.glb or glTF/*.gltf, skipped\n",
+                   name.c_str());
+    }
+  }
+  return models;
+}
+
+/// A fresh directory under the system temp directory, removed with everything in it on
+/// destruction.
+class TempDir {
+ public:
+  TempDir() {
+    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
+    path_ = fs::temp_directory_path() / ("covrast_bench_frame_" + std::to_string(ticks));
+    fs::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    fs::remove_all(path_, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  const fs::path& path() const { return path_; }
+
+ private:
+  fs::path path_;
+};
+
+/// Runs `scenegen --real dir`; returns the JSON files it wrote (sorted), or nothing with a note
+/// on stderr when the generator lacks the option (non-zero exit status or no JSON written).
+std::vector<fs::path> generate_real_scenes(const std::string& scenegen, const fs::path& dir) {
+  const std::string command =
+      "\"" + scenegen + "\" --real \"" + dir.string() + "\" >/dev/null 2>&1";
+  const int status = std::system(command.c_str());
+  const int exit_status = status != -1 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::vector<fs::path> scenes = files_with_extension(dir, ".json");
+  if (exit_status != 0 || scenes.empty()) {
+    std::fprintf(stderr,
+                 "bench_frame: %s --real is not supported (exit status %d, %zu JSON files): the "
+                 "frame/real:* scenes are skipped\n",
+                 scenegen.c_str(), exit_status, scenes.size());
+    return {};
+  }
+  return scenes;
 }
 
 void register_frame(const std::string& name, std::function<covrast::Scene()> make,
@@ -147,7 +298,7 @@ void register_frame(const std::string& name, std::function<covrast::Scene()> mak
       ->UseRealTime();
 }
 
-void register_all() {
+void register_all(ContentSize size, const std::string& scenegen, const fs::path& real_dir) {
   std::vector<covrast::RenderMode> modes;
   for (const char* text : {"aliased", "coverage", "coverage-blend", "msaa:4", "msaa:8", "msaa:16",
                            "ssaa:2", "ssaa:4", "ssaa:8", "ssaa:16"}) {
@@ -184,37 +335,90 @@ void register_all() {
     }
   }
 
-  // Sample models, when present.
-  std::vector<fs::path> models;
-  std::error_code ec;
-  if (fs::is_directory(kModelDir, ec)) {
-    for (const auto& entry : fs::directory_iterator(kModelDir, ec)) {
-      if (entry.path().extension() == ".obj") models.push_back(entry.path());
+  // Generated real-content scenes, when the generator has --real.
+  const std::vector<covrast::RenderMode> content_modes = [&modes] {
+    std::vector<covrast::RenderMode> picked;
+    for (const covrast::RenderMode& mode : modes) {
+      const std::string text = covrast::to_string(mode);
+      if (text == "aliased" || text == "coverage" || text == "coverage-blend" || text == "msaa:4") {
+        picked.push_back(mode);
+      }
     }
-  }
-  std::sort(models.begin(), models.end());
-  if (models.empty()) {
-    benchmark::RegisterBenchmark("frame/model:none", [](benchmark::State& state) {
-      state.SkipWithError("no OBJ models: ../shared/models not found or empty");
+    return picked;
+  }();
+  const std::vector<fs::path> real = generate_real_scenes(scenegen, real_dir);
+  if (real.empty()) {
+    benchmark::RegisterBenchmark("frame/real:none", [](benchmark::State& state) {
+      state.SkipWithError("covrast-scenegen --real is not supported by this build");
     });
   }
-  for (const fs::path& model : models) {
-    for (const char* text : {"aliased", "coverage", "coverage-blend"}) {
+  for (const fs::path& scene : real) {
+    for (const covrast::RenderMode& mode : content_modes) {
       covrast::RenderOptions options;
-      options.mode = covrast::parse_render_mode(text);
+      options.mode = mode;
       register_frame(
-          "frame/model:" + model.filename().string() + "/" + text,
-          [model] { return framed_model_scene(model); }, model.string(), options);
+          "frame/real:" + safe_name(scene.stem().string()) + "/" + covrast::to_string(mode),
+          [scene, size] { return sized_scene(scene, size); }, scene.string(), options);
     }
   }
+
+  // Sample models, when present.
+  const std::vector<Model> models = find_models(kModelDir);
+  if (models.empty()) {
+    benchmark::RegisterBenchmark("frame/model:none", [](benchmark::State& state) {
+      state.SkipWithError("no sample models: ../shared/models not found or empty");
+    });
+  }
+  for (const Model& model : models) {
+    for (const covrast::RenderMode& mode : content_modes) {
+      covrast::RenderOptions options;
+      options.mode = mode;
+      const fs::path file = model.file;
+      register_frame(
+          "frame/model:" + model.name + "/" + covrast::to_string(mode),
+          [file, size] { return framed_model_scene(file, size); }, file.string(), options);
+    }
+  }
+}
+
+/// Takes this program's own options (--size=WxH, --scenegen=PATH) out of argv; returns false
+/// with a message on stderr for a malformed one.
+bool take_own_options(int& argc, char** argv, ContentSize& size, std::string& scenegen) {
+  int kept = 1;
+  for (int i = 1; i < argc; ++i) {
+    const char* arg = argv[i];
+    if (std::strncmp(arg, "--size=", 7) == 0) {
+      int w = 0, h = 0;
+      char tail = 0;
+      if (std::sscanf(arg + 7, "%dx%d%c", &w, &h, &tail) != 2 || w < 1 || h < 1 || w > 16384 ||
+          h > 16384) {
+        std::fprintf(stderr, "bench_frame: --size: expected WxH (1..16384), got '%s'\n", arg + 7);
+        return false;
+      }
+      size = {w, h};
+    } else if (std::strncmp(arg, "--scenegen=", 11) == 0) {
+      scenegen = arg + 11;
+    } else {
+      argv[kept++] = argv[i];
+    }
+  }
+  argc = kept;
+  argv[argc] = nullptr;
+  return true;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
+  ContentSize size;
+  std::string scenegen = COVRAST_SCENEGEN_PATH;
+  if (!take_own_options(argc, argv, size, scenegen)) return 1;
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  register_all();
+  // The real scenes are loaded when their first benchmark runs, so the directory they are
+  // written into lives until every benchmark has run.
+  const TempDir real_dir;
+  register_all(size, scenegen, real_dir.path());
   benchmark::RunSpecifiedBenchmarks();
   benchmark::Shutdown();
   return 0;

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Quality-versus-cost report for covrast (issue 5, sections 4-5): writes docs/benchmarks.md.
+"""Quality-versus-cost report for covrast (issues 5 and 10): writes docs/benchmarks.md.
 
 Renders every benchmark scene in every anti-aliasing mode with the covrast command line, and
 for each mode records
@@ -10,18 +10,35 @@ The reference is slow (seconds per 640x360 frame), so the error figures are meas
 smaller size (`--error-size`, default 640x360: every mode is rendered a second time at the
 scene's size scaled down to fit that box). The report holds a table per scene, an
 error-versus-time log-log plot per scene (matplotlib, when available), enlarged crops of one
-edge region, and a headline paragraph computed from the numbers.
+edge region, and headline checks computed from the numbers: per scene, whether coverage is
+(a) no slower than msaa:4 and (b) within 0.7x ssaa:16's RMSE and no worse than its largest
+error.
+
+Three sets of scenes:
+  - the bundled benchmark scenes (scenes/overlap.json, sphere_grid.json, slivers.json);
+  - generated real-content scenes: `covrast-scenegen --real DIR` (next to the covrast binary,
+    or `--scenegen`) writes DIR/<name>.json; every JSON it writes is a scene. A generator
+    without that option is detected (non-zero exit or no files) and the set is skipped;
+  - sample models from ../shared/models (`--models`): every OBJ there and the glTF models in
+    gltf/<Name>/, each framed by its bounding box with per-triangle colours. By default the
+    OBJ models and DEFAULT_GLTF_MODELS below; `--models-filter REGEX` picks models by name
+    from all of them, `--all-models` takes every one. A model that fails to load or has no
+    triangles is skipped with its reason; a missing folder leaves the set out.
+The generated scenes and the models are rendered at `--model-size` (default 640x360), where
+the reference takes seconds rather than minutes.
 
 Python standard library only, plus Debian's python3-matplotlib for the plots: the full report
 installs it with apt-get when it is missing; `--quick` never installs anything and skips the
 plots when matplotlib cannot be imported. Crops are cut and enlarged here (PNG read and written
 with zlib), so ImageMagick is not needed.
 
-  benchmarks/report.py                          # full report into docs/ (takes many minutes)
+  benchmarks/report.py                          # full report into docs/ (about 10 minutes)
+  benchmarks/report.py --out /tmp/r --models-filter 'Duck|teapot' --no-real
   benchmarks/report.py --quick --out /tmp/r     # 96x54, 1 frame, two scenes: a few seconds
 
 Exit status: 0 when every scene has a row for every mode and every render and comparison
 succeeded; 1 otherwise (the report is still written, with the failures in it); 2 on bad usage.
+Skipped models and a generator without `--real` are not failures.
 """
 
 import argparse
@@ -35,6 +52,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 import zlib
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -65,6 +83,42 @@ SCENES = [
     ("slivers", "scenes/slivers.json", "thin triangles, near-horizontal and near-vertical edges"),
 ]
 QUICK_SCENES = ["overlap", "slivers"]
+
+# The glTF sample models of the default run (with every OBJ model): the ones with the most
+# triangles, ReciprocatingSaw (198k, dense CAD) down to Fox (576), plus BoxTextured as the
+# trivial case. Left out by default, to keep the full report near 10 minutes:
+# MetalRoughSpheresNoTextures (1.04M triangles, its reference frame alone takes about 40 s at
+# 640x360) and the small feature tests (up to 524 triangles). `--all-models` or
+# `--models-filter` add them.
+DEFAULT_GLTF_MODELS = [
+    "ReciprocatingSaw",
+    "ClearCoatTest",
+    "DamagedHelmet",
+    "NegativeScaleTest",
+    "Lantern",
+    "CesiumMan",
+    "Duck",
+    "Avocado",
+    "Fox",
+    "BoxTextured",
+]
+# Which file of a glTF model folder is used: the first of these sub-folders that holds a file
+# with that extension. glTF-Binary and plain glTF first; the embedded and quantized variants
+# only for models published without those (Lantern, MeshPrimitiveModes, MultipleScenes,
+# AnimatedMorphCube). Draco-compressed files are never used: covrast cannot decode them.
+GLTF_VARIANTS = [
+    ("glTF-Binary", ".glb"),
+    ("glTF", ".gltf"),
+    ("glTF-Embedded", ".gltf"),
+    ("glTF-Quantized", ".gltf"),
+]
+MODEL_SIZE = (640, 360)
+
+# Headline checks: coverage must be no slower than TIME_RIVAL, and against the reference have
+# an RMSE of at most RMSE_FACTOR x QUALITY_RIVAL's and a largest error no worse than its.
+TIME_RIVAL = "msaa:4"
+QUALITY_RIVAL = "ssaa:16"
+RMSE_FACTOR = 0.7
 
 
 class Failure(Exception):
@@ -329,70 +383,213 @@ def samples_text(mode):
     return "exact area"
 
 
-def model_scenes(covrast, models_dir, tmp):
-    """A framed scene JSON per OBJ in models_dir: camera on +z looking at the centre of the
-    bounding box (from `covrast info --json`), far enough for the bounding sphere (radius r,
-    half the box diagonal) to fit the vertical field of view: distance = 1.05 r / sin(fovy/2).
-    Same framing as benchmarks/bench_frame.cpp."""
-    scenes = []
+def safe_name(text):
+    """text with every run of characters other than letters, digits, '_', '.' and '-' replaced
+    by '_': usable in file names and benchmark names ('Box With Spaces' -> 'Box_With_Spaces')."""
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", text)
+
+
+def gltf_file(folder):
+    """The glTF file used for one model folder (see GLTF_VARIANTS), or None."""
+    for variant, ext in GLTF_VARIANTS:
+        sub = os.path.join(folder, variant)
+        if os.path.isdir(sub):
+            files = sorted(f for f in os.listdir(sub) if f.lower().endswith(ext))
+            if files:
+                return os.path.join(sub, files[0])
+    return None
+
+
+def find_models(models_dir):
+    """Every sample model under models_dir. Returns (models, skipped): models a list of dicts
+    {name, file, key} (key is the scene's mesh key, "obj" or "gltf"), OBJ files of models_dir
+    first, then the folders of models_dir/gltf, each sorted by name; skipped a list of
+    (name, reason) for the glTF folders without a usable file."""
+    models, skipped = [], []
+    for entry in sorted(os.listdir(models_dir)):
+        if entry.lower().endswith(".obj"):
+            models.append({"name": safe_name(entry[: -len(".obj")]),
+                           "file": os.path.abspath(os.path.join(models_dir, entry)),
+                           "key": "obj"})
+    gltf_dir = os.path.join(models_dir, "gltf")
+    if os.path.isdir(gltf_dir):
+        for entry in sorted(os.listdir(gltf_dir)):
+            folder = os.path.join(gltf_dir, entry)
+            if not os.path.isdir(folder):
+                continue
+            path = gltf_file(folder)
+            if path is None:
+                variants = ", ".join(f"{v}/*{e}" for v, e in GLTF_VARIANTS)
+                skipped.append((safe_name(entry), f"no {variants} file"))
+                continue
+            name = safe_name(entry)
+            if any(m["name"] == name for m in models):
+                name += "_gltf"  # an OBJ model of the same name came first
+            models.append({"name": name, "file": os.path.abspath(path), "key": "gltf"})
+    return models, skipped
+
+
+def select_models(models, opts):
+    """The models to measure: those whose name matches --models-filter (searched, case
+    sensitive) when it is given, all with --all-models, else every OBJ model and the glTF
+    models of DEFAULT_GLTF_MODELS."""
+    if opts.models_filter:
+        pattern = re.compile(opts.models_filter)
+        return [m for m in models if pattern.search(m["name"])]
+    if opts.all_models:
+        return list(models)
+    default = {safe_name(n) for n in DEFAULT_GLTF_MODELS}
+    return [m for m in models if m["key"] == "obj" or m["name"] in default]
+
+
+def write_json(path, data):
+    """Writes data as JSON to path."""
+    with open(path, "w") as f:
+        json.dump(data, f)
+
+
+def framed_model_scene(covrast, model, size, tmp):
+    """Writes a scene JSON showing one model with per-triangle colours at size, and returns its
+    path. Camera on +z looking at the centre of the bounding box (from `covrast info --json`),
+    far enough for the bounding sphere (radius r, half the box diagonal) to fit the vertical
+    field of view: distance = 1.05 r / sin(fovy/2). Same framing as benchmarks/bench_frame.cpp.
+    Raises Failure (the reason to skip the model) when it does not load or has no triangles."""
+    path = os.path.join(tmp, f"model-{model['name']}.json")
+    scene = {
+        "width": size[0],
+        "height": size[1],
+        "background": [0.02, 0.02, 0.02],
+        "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40,
+                   "near": 0.1, "far": 100},
+        "meshes": [{model["key"]: model["file"], "color": "per_triangle"}],
+    }
+    write_json(path, scene)
+    info = scene_info(covrast, path)
+    if not info.get("triangles") or not info.get("bounds"):
+        raise Failure("no triangles")
+    lo, hi = info["bounds"]["min"], info["bounds"]["max"]
+    centre = [(a + b) / 2 for a, b in zip(lo, hi)]
+    radius = max(0.5 * math.dist(lo, hi), 1e-6)
+    distance = 1.05 * radius / math.sin(math.radians(40) / 2)
+    scene["camera"] = {
+        "eye": [centre[0], centre[1], centre[2] + distance],
+        "target": centre,
+        "up": [0, 1, 0],
+        "fovy_deg": 40,
+        "near": max(distance - 1.5 * radius, 1e-3 * distance),
+        "far": distance + 1.5 * radius,
+    }
+    write_json(path, scene)
+    return path
+
+
+def model_scenes(opts, tmp, notes):
+    """The framed scenes of the selected sample models (see find_models, select_models), as
+    scene dicts; appends to notes (shown with the headline) what was measured, what was left
+    out and why."""
+    models_dir = opts.models
     if not os.path.isdir(models_dir):
-        return scenes
-    for name in sorted(os.listdir(models_dir)):
-        if not name.endswith(".obj"):
-            continue
-        obj = os.path.abspath(os.path.join(models_dir, name))
-        stem = name[: -len(".obj")]
-        path = os.path.join(tmp, f"model-{stem}.json")
-        scene = {
-            "width": 1920,
-            "height": 1080,
-            "background": [0.02, 0.02, 0.02],
-            "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40,
-                       "near": 0.1, "far": 100},
-            "meshes": [{"obj": obj, "color": "per_triangle"}],
-        }
-        with open(path, "w") as f:
-            json.dump(scene, f)
+        notes.append(f"Sample models: not found (`{models_dir}` does not exist), so the model "
+                     "scenes are left out.")
+        log(f"models: {models_dir} not found, skipped")
+        return []
+    models, skipped = find_models(models_dir)
+    if not models:
+        notes.append(f"Sample models: none found in `{models_dir}`, so the model scenes are "
+                     "left out.")
+        log(f"models: none in {models_dir}, skipped")
+        return []
+    chosen = select_models(models, opts)
+    left_out = [m["name"] for m in models if m not in chosen]
+    scenes = []
+    for model in chosen:
         try:
-            info = scene_info(covrast, path)
+            path = framed_model_scene(opts.covrast, model, opts.model_size, tmp)
         except Failure as e:
-            log(f"model {name}: skipped ({e})")
+            skipped.append((model["name"], str(e)))
             continue
-        if not info.get("bounds"):
-            log(f"model {name}: skipped (no geometry)")
-            continue
-        lo, hi = info["bounds"]["min"], info["bounds"]["max"]
-        centre = [(a + b) / 2 for a, b in zip(lo, hi)]
-        radius = max(0.5 * math.dist(lo, hi), 1e-6)
-        distance = 1.05 * radius / math.sin(math.radians(40) / 2)
-        scene["camera"] = {
-            "eye": [centre[0], centre[1], centre[2] + distance],
-            "target": centre,
-            "up": [0, 1, 0],
-            "fovy_deg": 40,
-            "near": max(distance - 1.5 * radius, 1e-3 * distance),
-            "far": distance + 1.5 * radius,
-        }
-        with open(path, "w") as f:
-            json.dump(scene, f)
-        what = f"sample model {name}, per-triangle colours"
-        scenes.append((f"model-{stem}", path, what))
+        shown = os.path.relpath(model["file"], models_dir)
+        scenes.append({"name": f"model-{model['name']}", "path": path, "size": None,
+                       "what": f"Sample model `{shown}` (in `{models_dir}`), framed by its "
+                               "bounding box, per-triangle colours"})
+    how = (f"`--models-filter {opts.models_filter}`" if opts.models_filter else
+           "`--all-models`" if opts.all_models else
+           "the default selection: every OBJ model and the glTF models " +
+           ", ".join(DEFAULT_GLTF_MODELS))
+    size = opts.size or opts.model_size
+    text = (f"Sample models from `{models_dir}`, framed by their bounding boxes with "
+            f"per-triangle colours at {size[0]}x{size[1]}: "
+            f"{len(scenes)} measured ({how}).")
+    if left_out:
+        text += f" Not selected: {', '.join(left_out)}."
+    if skipped:
+        text += " Skipped: " + "; ".join(f"{n} ({why})" for n, why in skipped) + "."
+    notes.append(text)
+    for name, why in skipped:
+        log(f"model {name}: skipped ({why})")
     return scenes
 
 
-def measure_scene(opts, name, path, what, tmp):
-    """Renders one scene in every mode. Returns a dict with sizes, rows and failures."""
-    covrast = opts.covrast
+def real_scenes(opts, tmp, notes):
+    """The generated real-content scenes: runs `covrast-scenegen --real DIR` and returns a
+    scene dict per JSON file it wrote into DIR. A generator that lacks the option (non-zero
+    exit status, or no JSON written) gives no scenes and a note (shown with the headline)
+    saying so."""
+    scenegen = opts.scenegen
+    if not os.access(scenegen, os.X_OK):
+        notes.append(f"Generated real-content scenes: skipped, `{scenegen}` is not an executable.")
+        log(f"real scenes: {scenegen} not found, skipped")
+        return []
+    out = os.path.join(tmp, "real")
+    os.makedirs(out, exist_ok=True)
+    proc = subprocess.run([scenegen, "--real", out], capture_output=True, text=True)
+    files = sorted(f for f in os.listdir(out) if f.endswith(".json"))
+    if proc.returncode != 0 or not files:
+        lines = [l for l in proc.stderr.splitlines() if l.strip()]
+        why = (f"exit status {proc.returncode}" + (f": {lines[0].strip()}" if lines else "")
+               if proc.returncode != 0 else "it wrote no JSON file")
+        notes.append("Generated real-content scenes: skipped, `covrast-scenegen --real DIR` is "
+                     f"not supported by this build ({why}).")
+        log(f"real scenes: covrast-scenegen --real not supported ({why}), skipped")
+        return []
+    if opts.quick:
+        notes.append(f"Generated real-content scenes: `covrast-scenegen --real` wrote {len(files)} "
+                     f"({', '.join(files)}); not rendered in quick mode.")
+        return []
+    scenes = []
+    for f in files:
+        stem = f[: -len(".json")]
+        scenes.append({"name": f"real-{safe_name(stem)}", "path": os.path.join(out, f),
+                       "size": opts.model_size,
+                       "what": f"Generated scene `{f}` (`covrast-scenegen --real DIR`)"})
+    size = opts.size or opts.model_size
+    notes.append(f"Generated real-content scenes: {len(files)} written by `covrast-scenegen "
+                 f"--real DIR` ({', '.join(f[:-5] for f in files)}), rendered at "
+                 f"{size[0]}x{size[1]}.")
+    return scenes
+
+
+def empty_result(scene):
+    """A result dict for the scene with no measurements yet."""
+    return dict(scene, triangles=0, time_size=(0, 0), error_size=(0, 0), threads=None,
+                rows={}, images={})
+
+
+def measure_scene(opts, scene, tmp):
+    """Renders one scene in every mode. The scene is a dict: name, path, what, and size (the
+    size to render at unless --size is given, or None for the scene file's own). Returns the
+    scene dict extended with sizes, triangle count, rows and images; a failed mode's row holds
+    its error."""
+    covrast, name, path = opts.covrast, scene["name"], scene["path"]
     info = scene_info(covrast, path)
     native = (info["width"], info["height"])
-    time_size = opts.size or native
+    time_size = opts.size or scene["size"] or native
     error_size = time_size if opts.error_size is None else fit_size(time_size, opts.error_size)
     same = error_size == time_size
     work = os.path.join(tmp, name)
     os.makedirs(work, exist_ok=True)
-    result = {"name": name, "path": path, "what": what, "triangles": info["triangles"],
-              "time_size": time_size, "error_size": error_size, "rows": {}, "images": {},
-              "threads": None}
+    result = empty_result(scene)
+    result.update(triangles=info["triangles"], time_size=time_size, error_size=error_size)
     sz = lambda s: f"{s[0]}x{s[1]}"  # noqa: E731
     log(f"== {name}: timing at {sz(time_size)}, error at {sz(error_size)}")
 
@@ -403,7 +600,8 @@ def measure_scene(opts, name, path, what, tmp):
         row = {"mode": mode, "samples": samples_text(mode)}
         result["rows"][mode] = row
         try:
-            repeat = opts.reference_repeat if mode == "reference" and not same else opts.repeat
+            # The reference takes seconds per frame: timed on --reference-repeat frames.
+            repeat = opts.reference_repeat if mode == "reference" else opts.repeat
             timed_png = os.path.join(work, f"time-{tag}.png")
             stats = render(covrast, path, timed_png, mode, time_size, repeat, opts.threads)
             row["ms"], row["frames"] = stats["render_ms"], stats["frames"]
@@ -472,9 +670,9 @@ def ok(row):
     return "error" not in row and "rmse" in row
 
 
-def headline(results):
+def ssaa_comparison(results):
     """Sentences computed from the numbers: coverage against the cheapest ssaa:N that matches
-    its RMSE, per scene, then a count over scenes."""
+    its RMSE, one per scene, then a count over scenes (a list of strings)."""
     sentences, matched, total, faster = [], 0, 0, 0
     for r in results:
         rows = r["rows"]
@@ -489,9 +687,10 @@ def headline(results):
         match = next((s for s in ssaa if s["rmse"] <= cov["rmse"]), None)
         if match is None and ssaa:
             best = ssaa[-1]
+            times = (f"{best['rmse'] / cov['rmse']:.1f}x coverage's" if cov["rmse"] > 0 else
+                     "coverage's is 0: the same image as the reference")
             text += (f"; no ssaa mode up to {best['mode']} matches it ({best['mode']}: RMSE "
-                     f"{fmt_rmse(best['rmse'])}, {best['rmse'] / max(cov['rmse'], 1e-300):.1f}x "
-                     f"coverage's, in {fmt_ms(best['ms'])} ms)")
+                     f"{fmt_rmse(best['rmse'])}, {times}, in {fmt_ms(best['ms'])} ms)")
         elif match is not None:
             n = int(match["mode"].split(":")[1])
             matched += 1
@@ -519,7 +718,110 @@ def headline(results):
         sentences.append(
             f"Over the {total} scenes, ssaa up to 16x16 matches coverage's RMSE in {matched}, and "
             f"where it does it is slower than coverage in {faster} of {matched}.")
-    return " ".join(sentences)
+    return sentences
+
+
+def scene_checks(r):
+    """The headline criteria for one scene result. Returns a dict with the numbers and, for
+    "time", "rmse", "max" and "quality", True, False or None (a row it needs is missing or
+    failed):
+      time:    coverage's time <= TIME_RIVAL's (both at the scene's timed size);
+      rmse:    coverage's RMSE <= RMSE_FACTOR x QUALITY_RIVAL's RMSE (against the reference);
+      max:     coverage's largest channel error <= QUALITY_RIVAL's;
+      quality: rmse and max."""
+    rows = r["rows"]
+    cov = rows.get("coverage", {})
+    fast, fine = rows.get(TIME_RIVAL, {}), rows.get(QUALITY_RIVAL, {})
+    timed = "error" not in cov and "ms" in cov and "error" not in fast and "ms" in fast
+    compared = ok(cov) and ok(fine)
+    check = {"time": None, "rmse": None, "max": None, "quality": None,
+             "cov": cov, "fast": fast, "fine": fine}
+    if timed:
+        check["time"] = cov["ms"] <= fast["ms"]
+    if compared:
+        check["rmse"] = cov["rmse"] <= RMSE_FACTOR * fine["rmse"]
+        check["max"] = cov["max_diff"] <= fine["max_diff"]
+        check["quality"] = check["rmse"] and check["max"]
+    return check
+
+
+def yes_no(value):
+    """A table cell for a criterion: yes, **no** (bold, so that failures stand out) or n/a."""
+    return "n/a" if value is None else ("yes" if value else "**no**")
+
+
+def cell_ms(row):
+    """A table cell with a mode's time, or 'failed'."""
+    return fmt_ms(row["ms"]) if "ms" in row and "error" not in row else "failed"
+
+
+def cell_rmse(row):
+    """A table cell with a mode's RMSE against the reference, or 'failed'."""
+    return fmt_rmse(row["rmse"]) if ok(row) else "failed"
+
+
+def cell_max(row):
+    """A table cell with a mode's largest channel error against the reference, or 'failed'."""
+    return str(row["max_diff"]) if ok(row) else "failed"
+
+
+def count_line(label, results, checks, key):
+    """One sentence: on how many scenes criterion `key` holds, and where it does not."""
+    held = [r["name"] for r, c in zip(results, checks) if c[key] is True]
+    failed = [r["name"] for r, c in zip(results, checks) if c[key] is False]
+    unknown = [r["name"] for r, c in zip(results, checks) if c[key] is None]
+    text = f"{label}: holds on {len(held)} of {len(results)} scenes"
+    text += (f", does not hold on {len(failed)} (" + ", ".join(f"`{n}`" for n in failed) + ")"
+             if failed else ", fails on none")
+    if unknown:
+        text += (f", and cannot be checked on {len(unknown)} (a mode failed: " +
+                 ", ".join(f"`{n}`" for n in unknown) + ")")
+    return text + "."
+
+
+def checks_section(results):
+    """Markdown lines for the headline checks: the criteria, a line per criterion counting
+    where it holds, and a table with yes/no per criterion per scene."""
+    checks = [scene_checks(r) for r in results]
+    lines = [
+        "Two checks per scene, both computed from the tables below:",
+        "",
+        f"- **(a) time**: coverage is no slower than covrast's own `{TIME_RIVAL}` (median "
+        "`render_ms`, at the scene's timed size);",
+        f"- **(b) quality**: against `reference`, coverage's RMSE is at most {RMSE_FACTOR}x "
+        f"`{QUALITY_RIVAL}`'s **and** its largest channel error is no larger than "
+        f"`{QUALITY_RIVAL}`'s.",
+        "",
+    ]
+    both = [r["name"] for r, c in zip(results, checks) if c["time"] and c["quality"]]
+    lines += [
+        "- " + count_line("(a) time", results, checks, "time"),
+        "- " + count_line("(b) quality", results, checks, "quality"),
+        "  - " + count_line(f"its RMSE part (<= {RMSE_FACTOR}x)", results, checks, "rmse"),
+        "  - " + count_line("its max-error part", results, checks, "max"),
+        f"- Both (a) and (b) hold on {len(both)} of {len(results)} scenes" +
+        (": " + ", ".join(f"`{n}`" for n in both) if both else "") + ".",
+        "",
+        f"| scene | triangles | size | coverage ms | {TIME_RIVAL} ms | (a) time | "
+        f"coverage RMSE | {QUALITY_RIVAL} RMSE | RMSE ratio | coverage max | "
+        f"{QUALITY_RIVAL} max | (b) RMSE | (b) max | (b) quality |",
+        "|---|---:|---|---:|---:|:-:|---:|---:|---:|---:|---:|:-:|:-:|:-:|",
+    ]
+    for r, c in zip(results, checks):
+        cov, fast, fine = c["cov"], c["fast"], c["fine"]
+        size = f"{r['time_size'][0]}x{r['time_size'][1]}"
+        if r["error_size"] != r["time_size"]:
+            size += f" (error {r['error_size'][0]}x{r['error_size'][1]})"
+        ratio = (f"{cov['rmse'] / fine['rmse']:.3f}" if ok(cov) and ok(fine) and fine["rmse"] > 0
+                 else "")
+        cells = [f"`{r['name']}`", f"{r['triangles']:,}", size, cell_ms(cov), cell_ms(fast),
+                 yes_no(c["time"]), cell_rmse(cov), cell_rmse(fine), ratio, cell_max(cov),
+                 cell_max(fine), yes_no(c["rmse"]), yes_no(c["max"]), yes_no(c["quality"])]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", f"*RMSE ratio: coverage's RMSE over {QUALITY_RIVAL}'s (at most {RMSE_FACTOR} "
+              "passes). Max: the largest single-channel error against the reference, in "
+              "8-bit sRGB units.*"]
+    return lines
 
 
 def machine_info():
@@ -550,27 +852,56 @@ def git_commit():
     return head + (" (with uncommitted changes)" if dirty else "")
 
 
-def write_report(opts, results, plots, crops, notes, md_path):
+def command_line(opts):
+    """The report.py command that reproduces this run's choices (paths left out)."""
+    cmd = "benchmarks/report.py" + (" --quick" if opts.quick else "")
+    if opts.repeat != (1 if opts.quick else 5):
+        cmd += f" --repeat {opts.repeat}"
+    if opts.size_given:
+        cmd += f" --size {opts.size[0]}x{opts.size[1]}"
+    if opts.model_size != MODEL_SIZE:
+        cmd += f" --model-size {opts.model_size[0]}x{opts.model_size[1]}"
+    if opts.models_filter:
+        cmd += f" --models-filter '{opts.models_filter}'"
+    elif opts.all_models:
+        cmd += " --all-models"
+    if opts.no_models and not opts.quick:
+        cmd += " --no-models"
+    if opts.no_real and not opts.quick:
+        cmd += " --no-real"
+    if opts.scenes:
+        cmd += f" --scenes {opts.scenes}"
+    return cmd
+
+
+def write_report(opts, results, plots, crops, set_notes, notes, md_path):
+    """Writes the Markdown report: headline checks with the notes on the scene sets, the
+    comparison with supersampling, the method with the other notes, then a section per scene
+    (table, plot, crops)."""
     model, cpus = machine_info()
     load = " ".join(f"{x:.1f}" for x in os.getloadavg())
     threads = next((r["threads"] for r in results if r["threads"] is not None), "?")
     sz = lambda s: f"{s[0]}x{s[1]}"  # noqa: E731
     now = datetime.datetime.now(datetime.timezone.utc)
     all_threads = ", all hardware threads" if opts.threads == 0 else ""
-    cmd = "benchmarks/report.py" + (" --quick" if opts.quick else "")
-    if opts.repeat != (1 if opts.quick else 5):
-        cmd += f" --repeat {opts.repeat}"
     lines = [
         "# Benchmarks: quality versus cost",
         "",
-        f"Generated by `{cmd}`; do not edit by hand, rerun the script.",
+        f"Generated by `{command_line(opts)}`; do not edit by hand, rerun the script.",
         "Every mode of every scene is timed with `covrast render SCENE --stats --repeat K` and",
         "compared with the `reference` mode (64x64 stratified samples per pixel in double",
         "precision) with `covrast compare --json`.",
         "",
-        "## Headline",
+        "## Headline checks",
         "",
-        headline(results),
+    ]
+    lines += checks_section(results)
+    lines += ["", "Scenes: the bundled benchmark scenes (`scenes/`), then the generated "
+              "real-content scenes (`real-*`), then the sample models (`model-*`)."]
+    lines += [""] + [f"- {n}" for n in set_notes]
+    lines += ["", "## Coverage against supersampling", ""]
+    lines += [f"- {t}" for t in ssaa_comparison(results)]
+    lines += [
         "",
         "## Method",
         "",
@@ -580,15 +911,19 @@ def write_report(opts, results, plots, crops, notes, md_path):
         f"- Threads: {threads} (`--threads {opts.threads}`{all_threads}); tile 64.",
         f"- Time (ms): the median `render_ms` of K = {opts.repeat} frames at the size in the",
         "  scene's heading (the whole frame, without loading or PNG encoding).",
+        f"  The reference is timed on {opts.reference_repeat} frame(s) only: it is slow.",
+        f"- Sizes: the bundled scenes at their own size; the generated scenes and the sample "
+        f"models at `--model-size {sz(opts.model_size)}`" +
+        (f"; everything at `--size {sz(opts.size)}` in this run." if opts.size else "."),
     ]
     if any(r["error_size"] != r["time_size"] for r in results):
         lines += [
-            f"  The reference is timed on {opts.reference_repeat} frame(s) only: it is slow.",
-            "- Error: the reference at the scenes' own sizes would dominate the run, so every mode",
-            "  is rendered a second time at the error size (`--error-size "
-            f"{sz(opts.error_size)}`: the scene's",
-            "  size scaled down to fit that box) and compared there. The error figures therefore",
-            "  describe the same scene at a lower resolution than the times, where a larger share",
+            "- Error: the reference at the scenes' own sizes would dominate the run, so a scene",
+            "  timed at a larger size than the error size (`--error-size "
+            f"{sz(opts.error_size)}`) is rendered a",
+            "  second time in every mode at its size scaled down to fit that box, and compared",
+            "  there; the others are compared on the timed images. The error figures therefore",
+            "  may describe a scene at a lower resolution than its times, where a larger share",
             "  of the pixels lies on edges.",
         ]
     else:
@@ -612,13 +947,11 @@ def write_report(opts, results, plots, crops, notes, md_path):
         name = r["name"]
         split = r["error_size"] != r["time_size"]
         overflow_head = "A-buffer overflows" + (" (timed / compared)" if split else "")
-        inside = r["path"].startswith(REPO + os.sep)
-        shown = os.path.relpath(r["path"], REPO) if inside else os.path.basename(r["path"])
         lines += [
             f"## {name}",
             "",
-            f"`{shown}` ({r['what']}; {r['triangles']:,} triangles). Time at "
-            f"{sz(r['time_size'])}, error at {sz(r['error_size'])}.",
+            f"{r['what']}; {r['triangles']:,} triangles. Time at {sz(r['time_size'])}, error at "
+            f"{sz(r['error_size'])}.",
             "",
             "| mode | samples per pixel | ms | RMSE (linear) | max error (/255) | "
             f"{overflow_head} |",
@@ -667,7 +1000,8 @@ def write_report(opts, results, plots, crops, notes, md_path):
 
 
 def check_report(md_path, results):
-    """Every scene section must have a table row for every mode; returns the problems."""
+    """Every scene section must have a table row for every mode, and every scene a row in the
+    headline checks; returns the problems."""
     with open(md_path) as f:
         text = f.read()
     problems = []
@@ -684,37 +1018,54 @@ def check_report(md_path, results):
         for mode, row in r["rows"].items():
             if "error" in row:
                 problems.append(f"{r['name']}: {mode} failed: {row['error']}")
+    checks = by_name.get("Headline checks", "")
+    for r in results:
+        if not re.search(r"^\| `" + re.escape(r["name"]) + r"` \|", checks, flags=re.M):
+            problems.append(f"{r['name']}: no row in the headline checks")
     return problems
 
 
-def main():
+def parse_options():
+    """The command line, checked and with the defaults of --quick filled in."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--covrast", default=os.path.join(REPO, "build", "release", "covrast"),
                         help="the covrast executable (default build/release/covrast)")
+    parser.add_argument("--scenegen", help="the covrast-scenegen executable for the generated "
+                        "scenes (default: covrast-scenegen next to --covrast)")
     parser.add_argument("--out", help="output directory for benchmarks.md and images/ "
                         "(default docs/; required with --quick)")
     parser.add_argument("--quick", action="store_true",
                         help="96x54 for everything, 1 frame, two scenes, no models: a smoke test")
     parser.add_argument("--repeat", type=int, help="frames per timing (default 5, quick 1)")
     parser.add_argument("--reference-repeat", type=int, default=1,
-                        help="frames when timing the reference at a size other than the error size")
+                        help="frames when timing the reference (default 1)")
     parser.add_argument("--size", type=parse_size, help="render every scene at WxH")
+    parser.add_argument("--model-size", type=parse_size, default=MODEL_SIZE,
+                        help="WxH of the sample models and the generated scenes (default "
+                        f"{MODEL_SIZE[0]}x{MODEL_SIZE[1]})")
     parser.add_argument("--error-size", default=None,
                         help="WxH box for the error images, or 'full' "
                         "(default 640x360; quick: full)")
     parser.add_argument("--threads", type=int, default=0, help="covrast --threads (0 = all)")
     parser.add_argument("--models", default=os.path.join(os.path.dirname(REPO), "shared", "models"),
-                        help="folder of OBJ models to add as scenes (default ../shared/models)")
-    parser.add_argument("--no-models", action="store_true", help="do not add the OBJ models")
-    parser.add_argument("--scenes", help="comma-separated subset of " +
+                        help="folder of the sample models: *.obj and gltf/<Name>/ "
+                        "(default ../shared/models)")
+    parser.add_argument("--models-filter", metavar="REGEX",
+                        help="only the models whose name (OBJ file stem or glTF folder, "
+                        "spaces as '_') matches REGEX, chosen from all of them")
+    parser.add_argument("--all-models", action="store_true",
+                        help="every model, not only the OBJ models and DEFAULT_GLTF_MODELS")
+    parser.add_argument("--no-models", action="store_true", help="leave out the sample models")
+    parser.add_argument("--no-real", action="store_true",
+                        help="leave out the scenes of covrast-scenegen --real")
+    parser.add_argument("--scenes", help="comma-separated subset of the bundled scenes " +
                         ",".join(s[0] for s in SCENES))
     parser.add_argument("--plot-spec", help=argparse.SUPPRESS)
     opts = parser.parse_args()
-
     if opts.plot_spec:
-        draw_plot(opts.plot_spec)
-        return 0
+        return opts
 
+    opts.size_given = opts.size
     if opts.quick:
         if not opts.out:
             parser.error("--quick needs --out DIR (it must not overwrite docs/)")
@@ -730,29 +1081,39 @@ def main():
         opts.error_size = None if error_text == "full" else parse_size(error_text)
     except argparse.ArgumentTypeError as e:
         parser.error(f"--error-size: {e}")
+    if opts.models_filter:
+        try:
+            re.compile(opts.models_filter)
+        except re.error as e:
+            parser.error(f"--models-filter: {e}")
     opts.covrast = os.path.abspath(opts.covrast)
     if not os.access(opts.covrast, os.X_OK):
         parser.error(f"{opts.covrast}: not an executable (build covrast first, or pass --covrast)")
-    out_dir = os.path.abspath(opts.out or os.path.join(REPO, "docs"))
-    images_dir = os.path.join(out_dir, "images")
-    os.makedirs(images_dir, exist_ok=True)
-
-    wanted = [s for s in SCENES if s[0] in QUICK_SCENES] if opts.quick else list(SCENES)
+    opts.scenegen = os.path.abspath(
+        opts.scenegen or os.path.join(os.path.dirname(opts.covrast), "covrast-scenegen"))
+    opts.models = os.path.abspath(opts.models)
     if opts.scenes:
         names = opts.scenes.split(",")
         unknown = [n for n in names if n not in {s[0] for s in SCENES}]
         if unknown:
             parser.error("--scenes: unknown " + ", ".join(unknown))
+    return opts
+
+
+def bundled_scenes(opts):
+    """The bundled benchmark scenes of this run (all, the quick pair, or --scenes), as scene
+    dicts."""
+    wanted = [s for s in SCENES if s[0] in QUICK_SCENES] if opts.quick else list(SCENES)
+    if opts.scenes:
+        names = opts.scenes.split(",")
         wanted = [s for s in SCENES if s[0] in names]
+    return [{"name": name, "path": os.path.join(REPO, path), "size": None,
+             "what": f"`{path}` ({what})"} for name, path, what in wanted]
 
-    notes = []
-    if opts.quick:
-        notes.append("Quick mode (`--quick`): a smoke test at 96x54 with one frame and two scenes; "
-                     "the numbers mean little.")
-    elif opts.repeat < 5:
-        notes.append(f"K = {opts.repeat} instead of the default 5, to keep the run short on a "
-                     "shared machine.")
 
+def plotting_interpreter(opts, notes):
+    """A Python interpreter that can import matplotlib (installing python3-matplotlib for the
+    full report when none can), or None with a note saying why there are no plots."""
     interp = interpreter_with_matplotlib()
     if interp is None and not opts.quick:
         message = install_matplotlib()
@@ -764,55 +1125,87 @@ def main():
                      "--quick does not install it.")
     if interp is None:
         log("plots skipped: matplotlib cannot be imported")
+    return interp
+
+
+def plot_scene(interp, opts, result, images_dir, tmp):
+    """Draws the error-versus-time plot of one scene with interp; returns its file name in
+    images_dir, or None (logged) when there is nothing to draw or drawing failed."""
+    name = result["name"]
+    points = [{"mode": m, "ms": row["ms"], "rmse": row["rmse"]}
+              for m, row in result["rows"].items()
+              if ok(row) and row["rmse"] > 0 and row["ms"] > 0]
+    file = f"bench-{name}-error-vs-time.png"
+    sz = lambda s: f"{s[0]}x{s[1]}"  # noqa: E731
+    spec = {"points": points, "out": os.path.join(images_dir, file),
+            "title": f"{name}: error versus time", "repeat": opts.repeat,
+            "time_size": sz(result["time_size"]), "error_size": sz(result["error_size"])}
+    spec_path = os.path.join(tmp, f"plot-{name}.json")
+    write_json(spec_path, spec)
+    proc = subprocess.run([interp, os.path.abspath(__file__), "--plot-spec", spec_path],
+                          capture_output=True, text=True)
+    if proc.returncode == 0 and points:
+        return file
+    why = (proc.stderr.strip().splitlines() or ["no points"])[-1]
+    log(f"plot for {name} failed: {why}")
+    return None
+
+
+def main():
+    """Measures every scene, writes the report and checks it; returns the exit status."""
+    started = time.monotonic()
+    opts = parse_options()
+    if opts.plot_spec:
+        draw_plot(opts.plot_spec)
+        return 0
+    out_dir = os.path.abspath(opts.out or os.path.join(REPO, "docs"))
+    images_dir = os.path.join(out_dir, "images")
+    os.makedirs(images_dir, exist_ok=True)
+
+    notes = []
+    if opts.quick:
+        notes.append("Quick mode (`--quick`): a smoke test at 96x54 with one frame and two scenes "
+                     "and no sample models; the numbers mean little.")
+    elif opts.repeat < 5:
+        notes.append(f"K = {opts.repeat} instead of the default 5, to keep the run short on a "
+                     "shared machine.")
+    interp = plotting_interpreter(opts, notes)
 
     results, plots, crops = [], {}, {}
     with tempfile.TemporaryDirectory(prefix="covrast-report-") as tmp:
-        scenes = [(n, os.path.join(REPO, p), w) for n, p, w in wanted]
-        if not opts.no_models:
-            models = model_scenes(opts.covrast, opts.models, tmp)
-            if models:
-                scenes += models
-            else:
-                notes.append(f"No OBJ models in {opts.models}: the model scenes are left out.")
-                log(f"no models in {opts.models}, skipped")
-        for name, path, what in scenes:
+        scenes, set_notes = bundled_scenes(opts), []
+        if opts.no_real:
+            set_notes.append("Generated real-content scenes: left out (`--no-real`).")
+        else:
+            scenes += real_scenes(opts, tmp, set_notes)
+        if opts.no_models:
+            set_notes.append("Sample models: left out (" +
+                             ("`--quick`" if opts.quick else "`--no-models`") + ").")
+        else:
+            scenes += model_scenes(opts, tmp, set_notes)
+        for scene in scenes:
+            name = scene["name"]
             try:
-                result = measure_scene(opts, name, path, what, tmp)
+                result = measure_scene(opts, scene, tmp)
             except Failure as e:
                 log(f"== {name}: FAILED: {e}")
-                result = {"name": name, "path": path, "what": what, "triangles": 0,
-                          "time_size": (0, 0), "error_size": (0, 0), "threads": None,
-                          "images": {}, "rows": {m: {"mode": m, "samples": samples_text(m),
-                                                      "error": str(e)} for m in MODES}}
+                result = empty_result(scene)
+                result["rows"] = {m: {"mode": m, "samples": samples_text(m), "error": str(e)}
+                                  for m in MODES}
             results.append(result)
             try:
                 crops[name] = make_crops(result, images_dir, opts.quick)
             except (Failure, OSError, zlib.error) as e:
                 crops[name] = ([], None, f"crops failed: {e}")
             if interp:
-                points = [{"mode": m, "ms": row["ms"], "rmse": row["rmse"]}
-                          for m, row in result["rows"].items()
-                          if ok(row) and row["rmse"] > 0 and row["ms"] > 0]
-                file = f"bench-{name}-error-vs-time.png"
-                sz = lambda s: f"{s[0]}x{s[1]}"  # noqa: E731
-                spec = {"points": points, "out": os.path.join(images_dir, file),
-                        "title": f"{name}: error versus time", "repeat": opts.repeat,
-                        "time_size": sz(result["time_size"]),
-                        "error_size": sz(result["error_size"])}
-                spec_path = os.path.join(tmp, f"plot-{name}.json")
-                with open(spec_path, "w") as f:
-                    json.dump(spec, f)
-                proc = subprocess.run([interp, os.path.abspath(__file__), "--plot-spec", spec_path],
-                                      capture_output=True, text=True)
-                if proc.returncode == 0 and points:
-                    plots[name] = file
-                else:
-                    why = (proc.stderr.strip().splitlines() or ["no points"])[-1]
-                    log(f"plot for {name} failed: {why}")
+                plots[name] = plot_scene(interp, opts, result, images_dir, tmp)
 
+    seconds = time.monotonic() - started
+    took = f"{seconds / 60:.1f} minutes" if seconds >= 120 else f"{seconds:.0f} s"
+    notes.append(f"This run took {took} ({len(results)} scenes).")
     md_path = os.path.join(out_dir, "benchmarks.md")
-    write_report(opts, results, plots, crops, notes, md_path)
-    log(f"wrote {md_path}")
+    write_report(opts, results, plots, crops, set_notes, notes, md_path)
+    log(f"wrote {md_path} in {took}")
     problems = check_report(md_path, results)
     for p in problems:
         log(f"report: {p}")
