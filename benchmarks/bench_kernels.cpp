@@ -35,12 +35,12 @@
 // the scalar and the SIMD kernels (the best target for the scalar benchmark) on the same
 // inputs and fails if any output differs.
 #include "binning/tile_bins.hpp"
+#include "core/edge_function.hpp"
 #include "geometry/frontend.hpp"
-#include "raster/coverage_kernel.hpp"
-#include "raster/edge_function.hpp"
-#include "raster/sample_kernel.hpp"
-#include "raster/sample_pattern.hpp"
-#include "raster/sample_raster.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
+#include "raster/samples/sample_kernel.hpp"
+#include "raster/samples/sample_pattern.hpp"
+#include "raster/samples/sample_raster.hpp"
 
 #include <covrast/scene.hpp>
 

@@ -1,9 +1,10 @@
 // Coverage mode, exact by construction: the A-buffer adds exact areas only where fragments
 // provably do not overlap, and its fast paths give what the per-sample list resolve gives.
-#include "geometry/triangle_setup.hpp"
-#include "raster/tile_raster.hpp"
-#include "resolve/abuffer.hpp"
-#include "resolve/triangle_overlap.hpp"
+#include "core/tile_raster.hpp"
+#include "core/triangle_setup.hpp"
+#include "raster/coverage/abuffer.hpp"
+#include "raster/coverage/triangle_overlap.hpp"
+#include "raster/rasterizers.hpp"
 
 #include <covrast/compare.hpp>
 #include <covrast/renderer.hpp>

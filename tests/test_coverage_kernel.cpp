@@ -9,8 +9,8 @@
 // way CoverageRasterizer::draw (src/raster/coverage.cpp) does: groups of kColumnGroup
 // columns, lanes past the span zeroed, kernel on the partial runs and the piece width on
 // the interior.
-#include "geometry/triangle_setup.hpp"
-#include "raster/coverage_kernel.hpp"
+#include "core/triangle_setup.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
 
 #include <hwy/targets.h>
 

@@ -6,9 +6,10 @@
 //
 // Scenes are built in code. The camera looks down -z from (0, 0, 10); world_at() places a
 // vertex at a chosen pixel position and depth, so the screen geometry is known.
+#include "core/triangle_setup.hpp"
 #include "geometry/frontend.hpp"
-#include "geometry/triangle_setup.hpp"
-#include "raster/coverage_kernel.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
+#include "raster/rasterizers.hpp"
 
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -17,7 +18,7 @@
 
 #include <catch2/catch.hpp>
 
-#include "resolve/abuffer.hpp"
+#include "raster/coverage/abuffer.hpp"
 #include "test_meshes.hpp"
 
 #include <algorithm>

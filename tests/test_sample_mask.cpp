@@ -4,9 +4,9 @@
 // reference against a direct per-sample evaluation, and every Highway target compiled and
 // supported here against the scalar reference, bit for bit, on 200,000 random
 // (triangle, pixel) pairs.
-#include "geometry/triangle_setup.hpp"
-#include "raster/edge_function.hpp"
-#include "resolve/sample_mask.hpp"
+#include "core/edge_function.hpp"
+#include "core/triangle_setup.hpp"
+#include "raster/coverage/sample_mask.hpp"
 
 #include <hwy/targets.h>
 

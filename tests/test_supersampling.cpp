@@ -4,12 +4,13 @@
 // Most tests drive the tile rasterizers directly with screen triangles built here from
 // 24.8 fixed-point vertices, so the geometry is known exactly and the resolved linear
 // colours can be read before 8-bit encoding; the scene tests go through covrast::render.
-#include "geometry/triangle_setup.hpp"
-#include "raster/reference.hpp"
-#include "raster/sample_kernel.hpp"
-#include "raster/sample_pattern.hpp"
-#include "raster/sample_raster.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/srgb8.hpp"
+#include "core/triangle_setup.hpp"
+#include "raster/rasterizers.hpp"
+#include "raster/reference/reference.hpp"
+#include "raster/samples/sample_kernel.hpp"
+#include "raster/samples/sample_pattern.hpp"
+#include "raster/samples/sample_raster.hpp"
 #include "test_meshes.hpp"
 
 #include <covrast/renderer.hpp>

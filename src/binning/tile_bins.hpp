@@ -5,7 +5,7 @@
 // tile is therefore the global draw order, whatever the thread count.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <cstdint>
 #include <span>

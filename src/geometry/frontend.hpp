@@ -9,7 +9,7 @@
 // constructor in frontend.cpp for why that never changes the image).
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <covrast/scene.hpp>
 

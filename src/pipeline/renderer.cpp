@@ -9,8 +9,9 @@
 // sequence, tiles of a fixed grid), and each task writes only its own output, so the image
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
+#include "core/tile_raster.hpp"
 #include "geometry/frontend.hpp"
-#include "raster/tile_raster.hpp"
+#include "raster/rasterizers.hpp"
 
 #include <covrast/renderer.hpp>
 
@@ -268,27 +269,4 @@ RenderResult render(const Scene& scene, const RenderOptions& options) {
   return renderer.render_frame();
 }
 
-namespace detail {
-
-std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int tile_px) {
-  switch (mode.kind) {
-    case ModeKind::Aliased:
-      return make_aliased_rasterizer(tile_px);
-    case ModeKind::Coverage:
-      return make_coverage_rasterizer(tile_px, false);
-    case ModeKind::CoverageBlend:
-      return make_coverage_rasterizer(tile_px, true);
-    case ModeKind::Ssaa:
-      return make_ssaa_rasterizer(tile_px, mode.samples, false);
-    case ModeKind::SsaaGrid:
-      return make_ssaa_rasterizer(tile_px, mode.samples, true);
-    case ModeKind::Msaa:
-      return make_msaa_rasterizer(tile_px, mode.samples);
-    case ModeKind::Reference:
-      return make_reference_rasterizer(tile_px);
-  }
-  throw InputError("mode '" + to_string(mode) + "' is not available in this build yet");
-}
-
-}  // namespace detail
 }  // namespace covrast

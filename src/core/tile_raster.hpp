@@ -1,4 +1,6 @@
-// Raster stage interface: one rasterizer per mode, one instance per worker thread.
+// Core: the interface between the pipeline and the raster modes, one rasterizer per mode and
+// one instance per worker thread (the modes live in src/raster/<mode>/; raster/rasterizers.hpp
+// makes them).
 //
 // The pipeline hands a tile to a rasterizer as begin_tile, then every binned triangle in
 // draw order (one virtual call per triangle, never per pixel), then end_tile, which
@@ -6,10 +8,9 @@
 // rasterizer keeps is tile-local scratch, reused from tile to tile.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <covrast/image.hpp>
-#include <covrast/renderer.hpp>
 
 #include <cstdint>
 #include <memory>
@@ -41,17 +42,5 @@ class TileRasterizer {
 
 /// Largest tile side the rasterizers accept [pixels].
 inline constexpr int kMaxTilePx = 256;
-
-std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int tile_px);
-
-// Factories of the individual modes (raster/<mode>.cpp).
-std::unique_ptr<TileRasterizer> make_aliased_rasterizer(int tile_px);
-std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend);
-/// Tests: coverage rasterizers made from now on add every pixel one by one (no whole-tile or
-/// whole-block paths), which must give the same bytes.
-void force_coverage_pixel_path(bool on);
-std::unique_ptr<TileRasterizer> make_ssaa_rasterizer(int tile_px, int n, bool ordered_grid);
-std::unique_ptr<TileRasterizer> make_msaa_rasterizer(int tile_px, int k);
-std::unique_ptr<TileRasterizer> make_reference_rasterizer(int tile_px);
 
 }  // namespace covrast::detail

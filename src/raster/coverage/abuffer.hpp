@@ -31,12 +31,12 @@
 //    behind, or the background.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
-#include "raster/coverage_kernel.hpp"
-#include "raster/shading.hpp"
-#include "raster/tile_raster.hpp"
-#include "resolve/sample_mask.hpp"
-#include "resolve/triangle_overlap.hpp"
+#include "core/shading.hpp"
+#include "core/tile_raster.hpp"
+#include "core/triangle_setup.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/sample_mask.hpp"
+#include "raster/coverage/triangle_overlap.hpp"
 
 #include <cmath>
 #include <cstddef>

@@ -4,11 +4,11 @@
 // the scalar twins (sample_kernel_scalar.cpp), so every target gives the same bits;
 // tests/test_supersampling.cpp checks that on every target this CPU has.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "raster/sample_kernel.cpp"
+#define HWY_TARGET_INCLUDE "raster/samples/sample_kernel.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "raster/sample_kernel.hpp"
+#include "raster/samples/sample_kernel.hpp"
 
 #include <limits>
 

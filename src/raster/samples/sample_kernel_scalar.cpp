@@ -1,6 +1,6 @@
 // Raster stage, sample-based modes: the scalar twins of the SIMD kernels
 // (sample_kernel.cpp), one lane at a time with the same operations in the same order.
-#include "raster/sample_kernel.hpp"
+#include "raster/samples/sample_kernel.hpp"
 
 #include <algorithm>
 #include <limits>

@@ -21,12 +21,12 @@
 // and lane * dy (at most 15 * 2^25) fit as well. Larger edges take the scalar reference.
 // tests/test_sample_mask.cpp checks the bits on every target.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "resolve/sample_mask.cpp"
+#define HWY_TARGET_INCLUDE "raster/coverage/sample_mask.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "raster/edge_function.hpp"
-#include "resolve/sample_mask.hpp"
+#include "core/edge_function.hpp"
+#include "raster/coverage/sample_mask.hpp"
 
 #include <algorithm>
 #include <cstdlib>

@@ -4,9 +4,10 @@
 // every sample the triangle wins; box-filter resolve in linear light (sample_raster.hpp).
 // Per-sample depth is what keeps the edge shared by a near and a far triangle free of the
 // background ("black edge" of one-depth-per-pixel MSAA).
-#include "raster/sample_pattern.hpp"
-#include "raster/sample_raster.hpp"
-#include "raster/tile_raster.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/rasterizers.hpp"
+#include "raster/samples/sample_pattern.hpp"
+#include "raster/samples/sample_raster.hpp"
 
 #include <covrast/error.hpp>
 

@@ -15,7 +15,7 @@
 // disjoint: the overlap has zero area.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <cstdint>
 

@@ -5,11 +5,12 @@
 //  - coverage:       the A-buffer (resolve/abuffer.hpp), which resolves it without seams;
 //  - coverage-blend: the literal seed, alpha-blended over the frame buffer with one depth
 //                    per pixel (kept to show what the A-buffer fixes).
-#include "raster/coverage_kernel.hpp"
-#include "raster/shading.hpp"
-#include "raster/tile_raster.hpp"
-#include "resolve/abuffer.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/coverage/abuffer.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
+#include "raster/rasterizers.hpp"
 
 #include <algorithm>
 #include <atomic>

@@ -21,7 +21,7 @@
 // rounded, is the 8-bit alpha round(255 * area).
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <algorithm>
 #include <cstdint>

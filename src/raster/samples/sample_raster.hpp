@@ -10,9 +10,9 @@
 // 8-bit sRGB.
 #pragma once
 
-#include "raster/sample_kernel.hpp"
-#include "raster/sample_pattern.hpp"
-#include "raster/tile_raster.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/samples/sample_kernel.hpp"
+#include "raster/samples/sample_pattern.hpp"
 
 #include <hwy/aligned_allocator.h>
 

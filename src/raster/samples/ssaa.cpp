@@ -2,9 +2,10 @@
 // depth and shading, box-filter resolve (sample_raster.hpp). This file holds the two
 // sample patterns; the correlated multi-jittered generator is shared with the reference
 // mode (docs/supersampling.md).
-#include "raster/sample_pattern.hpp"
-#include "raster/sample_raster.hpp"
-#include "raster/tile_raster.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/rasterizers.hpp"
+#include "raster/samples/sample_pattern.hpp"
+#include "raster/samples/sample_raster.hpp"
 
 #include <covrast/error.hpp>
 

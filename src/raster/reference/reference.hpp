@@ -16,8 +16,8 @@
 // the row's triangles that touch the pixel, in draw order.
 #pragma once
 
-#include "raster/sample_pattern.hpp"
-#include "raster/tile_raster.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/samples/sample_pattern.hpp"
 
 #include <cstdint>
 #include <vector>

@@ -2,7 +2,7 @@
 // interpolation of vertex colours in linear light.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <algorithm>
 

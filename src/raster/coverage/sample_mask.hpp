@@ -14,7 +14,7 @@
 // the sample grid on int32 SIMD lanes (Highway dynamic dispatch).
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <bit>
 #include <cstdint>

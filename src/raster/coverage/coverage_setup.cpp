@@ -2,7 +2,7 @@
 // in double precision from the snapped vertices (see coverage_kernel.hpp for the formula),
 // and the scalar twins of the SIMD column set-up, kernel and fused group function
 // (coverage_kernel.cpp), which are the references those must match bit for bit.
-#include "raster/coverage_kernel.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
 
 #include <algorithm>
 #include <climits>

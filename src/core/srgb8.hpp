@@ -2,8 +2,8 @@
 // copy-out of a finished tile into the frame.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
-#include "raster/tile_raster.hpp"
+#include "core/tile_raster.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <cstdint>
 #include <span>

@@ -13,17 +13,18 @@
 //   end_tile shades each pixel once, for that triangle, at the same point (x + 0.5, y + 0.5):
 //   the colour the winning triangle would have written when it won.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "raster/aliased.cpp"
+#define HWY_TARGET_INCLUDE "raster/aliased/aliased.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
 #ifndef COVRAST_RASTER_ALIASED_SHARED_
 #define COVRAST_RASTER_ALIASED_SHARED_
 
-#include "raster/edge_function.hpp"
-#include "raster/shading.hpp"
-#include "raster/tile_raster.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/edge_function.hpp"
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
+#include "core/tile_raster.hpp"
+#include "raster/rasterizers.hpp"
 
 #include <algorithm>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // Resolve stage: sRGB encoding and tile copy-out; see srgb8.hpp.
-#include "resolve/srgb8.hpp"
+#include "core/srgb8.hpp"
 
 #include <covrast/scene.hpp>
 

@@ -1,11 +1,11 @@
 // Resolve stage, coverage mode: the A-buffer; see abuffer.hpp.
-#include "resolve/abuffer.hpp"
+#include "raster/coverage/abuffer.hpp"
 
-#include "raster/coverage_kernel.hpp"
-#include "raster/edge_function.hpp"
-#include "raster/shading.hpp"
-#include "resolve/sample_mask.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/edge_function.hpp"
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/sample_mask.hpp"
 
 #include <algorithm>
 #include <array>

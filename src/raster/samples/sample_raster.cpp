@@ -1,10 +1,10 @@
 // Raster stage, sample-based modes: the tile and band loop around the sample kernels
 // (sample_raster.hpp, sample_kernel.hpp).
-#include "raster/sample_raster.hpp"
+#include "raster/samples/sample_raster.hpp"
 
-#include "raster/edge_function.hpp"
-#include "raster/shading.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/edge_function.hpp"
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
 
 #include <algorithm>
 #include <chrono>

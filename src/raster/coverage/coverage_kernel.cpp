@@ -7,11 +7,11 @@
 // the row math (EdgeTerm) reorders only where the result is provably the same bits (see
 // there); tests/test_coverage_kernel.cpp checks every target this CPU has.
 #undef HWY_TARGET_INCLUDE
-#define HWY_TARGET_INCLUDE "raster/coverage_kernel.cpp"
+#define HWY_TARGET_INCLUDE "raster/coverage/coverage_kernel.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "raster/coverage_kernel.hpp"
+#include "raster/coverage/coverage_kernel.hpp"
 
 #include <climits>
 #include <type_traits>

@@ -11,7 +11,7 @@
 // top  <=> dy == 0 && dx > 0,   left <=> dy < 0.
 #pragma once
 
-#include "geometry/triangle_setup.hpp"
+#include "core/triangle_setup.hpp"
 
 #include <cstdint>
 

@@ -1,9 +1,10 @@
 // Raster stage, reference mode (reference.hpp): slow on purpose, exact by construction.
-#include "raster/reference.hpp"
+#include "raster/reference/reference.hpp"
+#include "raster/rasterizers.hpp"
 
-#include "raster/edge_function.hpp"
-#include "raster/shading.hpp"
-#include "resolve/srgb8.hpp"
+#include "core/edge_function.hpp"
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
 
 #include <algorithm>
 #include <limits>
