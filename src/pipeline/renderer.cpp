@@ -32,8 +32,8 @@ using detail::TriangleSetup;
 RenderMode parse_render_mode(std::string_view text) {
   auto fail = [&]() -> RenderMode {
     throw InputError("unknown mode '" + std::string(text) +
-                     "': expected aliased, coverage, coverage-blend, ssaa:N (N = 1..16), "
-                     "ssaa-grid:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
+                     "': expected aliased, coverage, coverage-blend, ssaa:N, ssaa-grid:N or "
+                     "ssaa-cmj:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
   };
   if (text == "aliased") return {ModeKind::Aliased, 1};
   if (text == "coverage") return {ModeKind::Coverage, 1};
@@ -45,9 +45,12 @@ RenderMode parse_render_mode(std::string_view text) {
   int n = 0;
   auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), n);
   if (ec != std::errc() || end != number.data() + number.size()) return fail();
-  if (name == "ssaa" || name == "ssaa-grid") {
+  if (name == "ssaa" || name == "ssaa-grid" || name == "ssaa-cmj") {
     if (n < 1 || n > 16) return fail();
-    return {name == "ssaa" ? ModeKind::Ssaa : ModeKind::SsaaGrid, n};
+    const ModeKind kind = name == "ssaa"        ? ModeKind::Ssaa
+                          : name == "ssaa-grid" ? ModeKind::SsaaGrid
+                                                : ModeKind::SsaaCmj;
+    return {kind, n};
   }
   if (name == "msaa") {
     if (n != 2 && n != 4 && n != 8 && n != 16) return fail();
@@ -68,6 +71,8 @@ std::string to_string(const RenderMode& mode) {
       return "ssaa:" + std::to_string(mode.samples);
     case ModeKind::SsaaGrid:
       return "ssaa-grid:" + std::to_string(mode.samples);
+    case ModeKind::SsaaCmj:
+      return "ssaa-cmj:" + std::to_string(mode.samples);
     case ModeKind::Msaa:
       return "msaa:" + std::to_string(mode.samples);
     case ModeKind::Reference:
@@ -279,9 +284,9 @@ std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int
     case ModeKind::CoverageBlend:
       return make_coverage_rasterizer(tile_px, true);
     case ModeKind::Ssaa:
-      return make_ssaa_rasterizer(tile_px, mode.samples, false);
     case ModeKind::SsaaGrid:
-      return make_ssaa_rasterizer(tile_px, mode.samples, true);
+    case ModeKind::SsaaCmj:
+      return make_ssaa_rasterizer(tile_px, mode);
     case ModeKind::Msaa:
       return make_msaa_rasterizer(tile_px, mode.samples);
     case ModeKind::Reference:
