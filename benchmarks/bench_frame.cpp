@@ -70,6 +70,7 @@ int samples_per_pixel(const covrast::RenderMode& mode) {
   switch (mode.kind) {
     case covrast::ModeKind::Ssaa:
     case covrast::ModeKind::SsaaGrid:
+    case covrast::ModeKind::SsaaCmj:
       return mode.samples * mode.samples;
     case covrast::ModeKind::Msaa:
       return mode.samples;

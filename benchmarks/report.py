@@ -68,7 +68,8 @@ MODES = [
     "ssaa:4",
     "ssaa:8",
     "ssaa:16",
-    "ssaa-grid:4",
+    "ssaa-cmj:4",
+    "ssaa-cmj:16",
     "reference",
 ]
 CROP_MODES = ["aliased", "coverage", "coverage-blend", "msaa:4", "ssaa:4", "ssaa:16", "reference"]
@@ -334,6 +335,7 @@ def draw_plot(spec_path):
             "msaa": ("^", "C2", 40),
             "ssaa": ("o", "C0", 40),
             "ssaa-grid": ("D", "C4", 40),
+            "ssaa-cmj": ("D", "C5", 40),
         }.get(family, ("o", "C7", 40))
         ax.scatter([p["ms"]], [p["rmse"]], marker=marker, color=color, s=size, zorder=3)
         ax.annotate(mode, (p["ms"], p["rmse"]), textcoords="offset points", xytext=(6, 4),
@@ -372,7 +374,7 @@ def fit_size(size, box):
 
 def samples_text(mode):
     kind, _, n = mode.partition(":")
-    if kind in ("ssaa", "ssaa-grid"):
+    if kind in ("ssaa", "ssaa-grid", "ssaa-cmj"):
         return f"{int(n) ** 2} ({n}x{n})"
     if kind == "msaa":
         return f"{n} (shaded once)"

@@ -29,7 +29,7 @@ check() {  # scene mode size
   fi
 }
 for scene in default slivers boxes near_plane overlap; do
-  for mode in aliased coverage coverage-blend msaa:4 msaa:16 ssaa:4 ssaa-grid:3; do
+  for mode in aliased coverage coverage-blend msaa:4 msaa:16 ssaa:4 ssaa-grid:3 ssaa-cmj:4; do
     check "$scene" "$mode" 320x180
   done
 done

@@ -1,4 +1,4 @@
-// Tests of the sample-based modes: ssaa:N, ssaa-grid:N, msaa:K and reference
+// Tests of the sample-based modes: ssaa:N, ssaa-grid:N, ssaa-cmj:N, msaa:K and reference
 // (src/raster/sample_raster.cpp, ssaa.cpp, msaa.cpp, reference.cpp, sample_kernel.cpp).
 //
 // Most tests drive the tile rasterizers directly with screen triangles built here from
@@ -256,9 +256,10 @@ Image encode_tile(covrast::detail::TileRasterizer& raster, const PixelRect& rect
   return image;
 }
 
+/// The ssaa-grid:N (grid) or ssaa-cmj:N (!grid) rasterizer.
 std::unique_ptr<SampleRasterizer> ssaa_raster(int tile_px, int n, bool grid) {
   return std::make_unique<SampleRasterizer>(
-      tile_px, grid ? covrast::detail::ssaa_grid_pattern(n) : covrast::detail::ssaa_pattern(n),
+      tile_px, grid ? covrast::detail::ssaa_grid_pattern(n) : covrast::detail::ssaa_cmj_pattern(n),
       ShadingRate::PerSample, covrast::detail::sample_kernels_simd());
 }
 
@@ -266,9 +267,15 @@ std::unique_ptr<SampleRasterizer> ssaa_raster(int tile_px, int n, bool grid) {
 
 // ---------------------------------------------------------------------------------------
 
-TEST_CASE("ssaa patterns are n-rooks on the 1/256 grid; ssaa-grid is the ordered grid", "[ssaa]") {
+TEST_CASE(
+    "ssaa-cmj patterns are n-rooks on the 1/256 grid; ssaa and ssaa-grid are the ordered grid",
+    "[ssaa]") {
   for (int n = 1; n <= 16; ++n) {
-    const SamplePattern p = covrast::detail::ssaa_pattern(n);
+    // ssaa:N uses the ordered grid (docs/supersampling.md says why).
+    const SamplePattern grid = covrast::detail::ssaa_grid_pattern(n);
+    REQUIRE(covrast::detail::ssaa_pattern(n).x == grid.x);
+    REQUIRE(covrast::detail::ssaa_pattern(n).y == grid.y);
+    const SamplePattern p = covrast::detail::ssaa_cmj_pattern(n);
     REQUIRE(p.size() == n * n);
     std::vector<int> per_column(std::size_t(n * n), 0), per_row(std::size_t(n * n), 0);
     std::vector<int> per_cell(std::size_t(n * n), 0);
@@ -304,7 +311,8 @@ TEST_CASE("ssaa patterns are n-rooks on the 1/256 grid; ssaa-grid is the ordered
   REQUIRE(g3.x[2] == 213);  // 213.33
 }
 
-// Error bounds (docs/supersampling.md). Both patterns put exactly one sample in each of the
+// Error bounds (docs/supersampling.md), for ssaa-cmj:N (n-rooks) and the ordered grid of
+// ssaa-grid:N and ssaa:N. Both patterns put exactly one sample in each of the
 // N x N cells of side 1/N (for N = 1, 2, 4, 8, 16 the cells are exact on the 1/256 grid).
 // The estimate of the area of K = triangle ∩ pixel is (1/N^2) * #samples inside, so
 //   error = sum over cells c of [ I(sample_c inside) / N^2 - area(K ∩ c) ],
@@ -341,7 +349,8 @@ TEST_CASE("ssaa coverage error against the exact area stays within its bound and
       c.n = n;
       c.grid = grid;
       c.raster = ssaa_raster(kTile, n, grid);
-      c.pattern = grid ? covrast::detail::ssaa_grid_pattern(n) : covrast::detail::ssaa_pattern(n);
+      c.pattern =
+          grid ? covrast::detail::ssaa_grid_pattern(n) : covrast::detail::ssaa_cmj_pattern(n);
       configs.push_back(std::move(c));
     }
   }
@@ -406,7 +415,7 @@ TEST_CASE("ssaa coverage error against the exact area stays within its bound and
   }
   for (std::size_t i = 0; i < configs.size(); ++i) {
     const Config& c = configs[i];
-    INFO((c.grid ? "ssaa-grid:" : "ssaa:")
+    INFO((c.grid ? "ssaa-grid:" : "ssaa-cmj:")
          << c.n << " max error " << c.max_error << " mean " << c.sum_error / c.partial_pixels
          << " axis-aligned max " << c.max_axis_error << "; " << c.first_violation);
     REQUIRE(c.violations == 0);
@@ -422,7 +431,7 @@ TEST_CASE("ssaa coverage error against the exact area stays within its bound and
   // reaches almost 1 / (2N) while n-rooks stays below 1 / N^2. Measured (max / mean error
   // over partly covered pixels):
   //   N:          1            2            4            8             16
-  //   ssaa      0.98/0.20    0.65/0.078   0.20/0.032   0.058/0.0089  0.024/0.0033
+  //   ssaa-cmj  0.98/0.20    0.65/0.078   0.20/0.032   0.058/0.0089  0.024/0.0033
   //   ssaa-grid 0.98/0.19    0.44/0.074   0.21/0.029   0.11/0.011    0.052/0.0047
   // and from N = 8 on n-rooks is ahead on both counts.
   for (std::size_t i = 1; i < std::size(ns); ++i) {
@@ -435,6 +444,115 @@ TEST_CASE("ssaa coverage error against the exact area stays within its bound and
       REQUIRE(rooks.max_error < grid.max_error);
       REQUIRE(rooks.sum_error / rooks.partial_pixels < grid.sum_error / grid.partial_pixels);
     }
+  }
+}
+
+namespace {
+
+/// Area of the half-plane c x + s y <= d inside the pixel [0, 1]^2, in closed form; c and s
+/// must both be nonzero. Reflecting x -> 1 - x where c < 0 (and y -> 1 - y where s < 0)
+/// turns it into a x + b y <= e with a = |c|, b = |s|, e = d - min(c, 0) - min(s, 0). The
+/// triangle {x, y >= 0 : a x + b y <= u} has the area F(u) = max(u, 0)^2 / (2ab), and
+/// inclusion-exclusion over the square's corners gives F(e) - F(e - a) - F(e - b) +
+/// F(e - a - b).
+double half_plane_area(double c, double s, double d) {
+  const double a = std::abs(c), b = std::abs(s);
+  const double e = d - std::min(c, 0.0) - std::min(s, 0.0);
+  auto f = [](double u) { return u > 0 ? u * u : 0.0; };
+  return (f(e) - f(e - a) - f(e - b) + f(e - a - b)) / (2 * a * b);
+}
+
+/// The same area by clipping the square's polygon to the half-plane (shoelace formula):
+/// an independent check of the closed form.
+double half_plane_area_clipped(double c, double s, double d) {
+  const glm::dvec2 square[4] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+  std::vector<glm::dvec2> poly;
+  for (int i = 0; i < 4; ++i) {
+    const glm::dvec2 p = square[i], q = square[(i + 1) % 4];
+    const double dp = d - (c * p.x + s * p.y), dq = d - (c * q.x + s * q.y);
+    if (dp >= 0) poly.push_back(p);
+    if ((dp >= 0) != (dq >= 0)) poly.push_back(p + (q - p) * (dp / (dp - dq)));
+  }
+  double area = 0;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const glm::dvec2 p = poly[i], q = poly[(i + 1) % poly.size()];
+    area += p.x * q.y - q.x * p.y;
+  }
+  return std::abs(area) / 2;
+}
+
+/// A straight edge through the pixel: the half-plane c x + s y <= d and its exact area.
+struct HalfPlane {
+  double c, s, d, area;
+};
+
+/// The fixed edge set: 720 normal directions (k + 0.5) * 0.5 deg over the whole circle
+/// (every edge direction with either side inside; none exactly axis-aligned), each with 64
+/// offsets d evenly spread across the range in which the line crosses the open pixel.
+std::vector<HalfPlane> edge_set() {
+  constexpr int kAngles = 720, kOffsets = 64;
+  const double pi = std::acos(-1.0);
+  std::vector<HalfPlane> edges;
+  for (int k = 0; k < kAngles; ++k) {
+    const double theta = (k + 0.5) * 2 * pi / kAngles;
+    const double c = std::cos(theta), s = std::sin(theta);
+    const double lo = std::min(c, 0.0) + std::min(s, 0.0), hi = std::max(c, 0.0) + std::max(s, 0.0);
+    for (int o = 0; o < kOffsets; ++o) {
+      const double d = lo + (hi - lo) * (o + 0.5) / kOffsets;
+      edges.push_back({c, s, d, half_plane_area(c, s, d)});
+    }
+  }
+  return edges;
+}
+
+/// RMSE over `edges` of the pattern's coverage estimate (samples inside / samples) against
+/// the exact area. Sample (x, y) is at (x / unit, y / unit) from the pixel's corner.
+double edge_rmse(const SamplePattern& p, const std::vector<HalfPlane>& edges) {
+  std::vector<double> x, y;
+  for (int i = 0; i < p.size(); ++i) {
+    x.push_back(double(p.x[std::size_t(i)]) / p.unit);
+    y.push_back(double(p.y[std::size_t(i)]) / p.unit);
+  }
+  double sum = 0;
+  for (const HalfPlane& e : edges) {
+    int inside = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) inside += e.c * x[i] + e.s * y[i] <= e.d;
+    const double error = double(inside) / p.size() - e.area;
+    sum += error * error;
+  }
+  return std::sqrt(sum / double(edges.size()));
+}
+
+}  // namespace
+
+// The default pattern must be at least as good a baseline as the ordered grid on straight
+// edges: for every N, the RMSE of its coverage of a half-plane through the pixel, over all
+// edge angles and positions, is no larger than that of ssaa-grid:N (no slack), and no
+// larger than that of the n-rooks ssaa-cmj:N. Measured (print with -s; docs/supersampling.md):
+//   N:         1      2      4      8       16
+//   ssaa-grid  0.249  0.0889 0.0317 0.0113  0.00408
+//   ssaa-cmj   0.280  0.102  0.0415 0.0119  0.00480
+TEST_CASE("ssaa:N has a straight-edge coverage RMSE no larger than ssaa-grid:N for N = 1..16",
+          "[ssaa]") {
+  const std::vector<HalfPlane> edges = edge_set();
+  REQUIRE(edges.size() == 720 * 64);
+  double worst_formula = 0;
+  for (const HalfPlane& e : edges) {
+    worst_formula =
+        std::max(worst_formula, std::abs(e.area - half_plane_area_clipped(e.c, e.s, e.d)));
+  }
+  REQUIRE(worst_formula < 1e-12);
+  double previous_grid = 1;
+  for (int n = 1; n <= 16; ++n) {
+    const double rmse = edge_rmse(covrast::detail::ssaa_pattern(n), edges);
+    const double grid = edge_rmse(covrast::detail::ssaa_grid_pattern(n), edges);
+    const double cmj = edge_rmse(covrast::detail::ssaa_cmj_pattern(n), edges);
+    INFO("N = " << n << ": ssaa " << rmse << ", ssaa-grid " << grid << ", ssaa-cmj " << cmj);
+    CHECK(rmse <= grid);
+    CHECK(rmse <= cmj);
+    // The measure is not degenerate: it falls with every N.
+    CHECK(grid < previous_grid);
+    previous_grid = grid;
   }
 }
 
@@ -526,10 +644,11 @@ TEST_CASE("a tessellation covers every sample exactly once in every sample-based
     }
     for (double s : sum) REQUIRE(std::abs(s - 1.0) < 1e-6);  // integer counts / S
   };
-  SECTION("ssaa:16 (a sample on every 1/256 column and row)") {
+  SECTION("ssaa-cmj:16 (a sample on every 1/256 column and row)") {
     check(*ssaa_raster(kTile, 16, false), kTile, rect);
   }
   SECTION("ssaa-grid:4") { check(*ssaa_raster(kTile, 4, true), kTile, rect); }
+  SECTION("ssaa-grid:16") { check(*ssaa_raster(kTile, 16, true), kTile, rect); }
   for (int k : {4, 16}) {
     DYNAMIC_SECTION("msaa:" << k) {
       SampleRasterizer raster(kTile, covrast::detail::msaa_pattern(k), ShadingRate::PerPixel,
@@ -585,7 +704,7 @@ TEST_CASE("seam scene: a closed sphere in the background colour renders exactly 
   int covered = 0;
   for (std::size_t i = 0; i < lit.rgb.size(); i += 3) covered += lit.rgb[i] == 255;
   REQUIRE(covered > 64 * 64 / 4);
-  for (const char* mode : {"ssaa:4", "ssaa-grid:4", "msaa:4", "reference"}) {
+  for (const char* mode : {"ssaa:4", "ssaa-grid:4", "ssaa-cmj:4", "msaa:4", "reference"}) {
     INFO(mode);
     Scene scene = s;
     if (std::string(mode) == "reference") scene.width = scene.height = 40;
@@ -762,6 +881,7 @@ TEST_CASE(
   const std::int64_t targets = covrast::detail::sample_kernel_targets() & hwy::SupportedTargets();
   int forced = 0;
   for (const char* mode : {"ssaa:1", "ssaa:2", "ssaa:3", "ssaa:4", "ssaa:16", "ssaa-grid:5",
+                           "ssaa-cmj:1", "ssaa-cmj:2", "ssaa-cmj:3", "ssaa-cmj:4", "ssaa-cmj:16",
                            "msaa:2", "msaa:4", "msaa:8", "msaa:16", "reference"}) {
     INFO(mode);
     const bool reference = std::string(mode) == "reference";
@@ -835,7 +955,8 @@ TEST_CASE("the SIMD kernels and their scalar twins give the same samples", "[ssa
   const PixelRect rect{8, 8, 8 + 24, 8 + 24};
   const glm::vec3 background(0.25f, 0.5f, 0.75f);
   std::vector<SamplePattern> patterns;
-  for (int n : {1, 2, 3, 5, 16}) patterns.push_back(covrast::detail::ssaa_pattern(n));
+  for (int n : {1, 2, 3, 5, 16}) patterns.push_back(covrast::detail::ssaa_cmj_pattern(n));
+  for (int n : {3, 16}) patterns.push_back(covrast::detail::ssaa_pattern(n));
   for (int k : {2, 4, 8, 16}) patterns.push_back(covrast::detail::msaa_pattern(k));
   int wide_triangles = 0;
   for (const TriangleSetup& t : tris) {
@@ -873,7 +994,7 @@ TEST_CASE("banded replay is reported as raster time, not resolve time", "[ssaa]"
                               {glm::vec3(1.0f), glm::vec3(1.0f), glm::vec3(1.0f)}, n));
   }
   const PixelRect rect{0, 0, 32, 32};
-  const SamplePattern pattern = covrast::detail::ssaa_pattern(16);
+  const SamplePattern pattern = covrast::detail::ssaa_cmj_pattern(16);
   SampleRasterizer banded(32, pattern, ShadingRate::PerPixel,
                           covrast::detail::sample_kernels_scalar(), 64 << 10);
   SampleRasterizer whole(32, pattern, ShadingRate::PerPixel,

@@ -19,8 +19,9 @@ enum class ModeKind {
   Aliased,        ///< one sample at the pixel centre, top-left fill rule
   Coverage,       ///< exact analytic area, A-buffer resolve (the default)
   CoverageBlend,  ///< exact analytic area blended over the frame buffer (seams show)
-  Ssaa,           ///< N x N stratified (n-rooks) samples, per-sample shading
+  Ssaa,           ///< N x N samples, per-sample shading: the ordered grid (as SsaaGrid)
   SsaaGrid,       ///< N x N ordered grid samples
+  SsaaCmj,        ///< N x N correlated multi-jittered (n-rooks) samples
   Msaa,           ///< K samples (D3D standard positions), shading once per pixel
   Reference,      ///< high-count supersampling in double precision: ground truth
 };
@@ -30,8 +31,8 @@ struct RenderMode {
   int samples = 1;  ///< N for ssaa (N x N), K for msaa; 1 otherwise
 };
 
-/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "msaa:K",
-/// "reference". Throws InputError listing the accepted forms.
+/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N",
+/// "msaa:K", "reference". Throws InputError listing the accepted forms.
 RenderMode parse_render_mode(std::string_view text);
 std::string to_string(const RenderMode& mode);
 

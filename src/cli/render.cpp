@@ -98,10 +98,12 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->required()
       ->type_name("SCENE.json");
   sub->add_option("-o,--output", args.output, "Output PNG file")->required()->type_name("OUT.png");
-  sub->add_option("--mode", args.mode,
-                  "Anti-aliasing mode: coverage (exact analytic area, the default), "
-                  "coverage-blend, aliased, ssaa:N and ssaa-grid:N (N x N samples, N = 1..16), "
-                  "msaa:K (K = 2, 4, 8, 16), reference (double-precision ground truth)")
+  sub->add_option(
+         "--mode", args.mode,
+         "Anti-aliasing mode: coverage (exact analytic area, the default), coverage-blend, "
+         "aliased, ssaa:N and ssaa-grid:N (N x N ordered grid, N = 1..16), ssaa-cmj:N (N x N "
+         "correlated multi-jittered), msaa:K (K = 2, 4, 8, 16), reference (double-precision "
+         "ground truth)")
       ->capture_default_str()
       ->type_name("MODE");
   sub->add_option(

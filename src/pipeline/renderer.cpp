@@ -33,8 +33,8 @@ using detail::TriangleSetup;
 RenderMode parse_render_mode(std::string_view text) {
   auto fail = [&]() -> RenderMode {
     throw InputError("unknown mode '" + std::string(text) +
-                     "': expected aliased, coverage, coverage-blend, ssaa:N (N = 1..16), "
-                     "ssaa-grid:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
+                     "': expected aliased, coverage, coverage-blend, ssaa:N, ssaa-grid:N or "
+                     "ssaa-cmj:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
   };
   if (text == "aliased") return {ModeKind::Aliased, 1};
   if (text == "coverage") return {ModeKind::Coverage, 1};
@@ -46,9 +46,12 @@ RenderMode parse_render_mode(std::string_view text) {
   int n = 0;
   auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), n);
   if (ec != std::errc() || end != number.data() + number.size()) return fail();
-  if (name == "ssaa" || name == "ssaa-grid") {
+  if (name == "ssaa" || name == "ssaa-grid" || name == "ssaa-cmj") {
     if (n < 1 || n > 16) return fail();
-    return {name == "ssaa" ? ModeKind::Ssaa : ModeKind::SsaaGrid, n};
+    const ModeKind kind = name == "ssaa"        ? ModeKind::Ssaa
+                          : name == "ssaa-grid" ? ModeKind::SsaaGrid
+                                                : ModeKind::SsaaCmj;
+    return {kind, n};
   }
   if (name == "msaa") {
     if (n != 2 && n != 4 && n != 8 && n != 16) return fail();
@@ -69,6 +72,8 @@ std::string to_string(const RenderMode& mode) {
       return "ssaa:" + std::to_string(mode.samples);
     case ModeKind::SsaaGrid:
       return "ssaa-grid:" + std::to_string(mode.samples);
+    case ModeKind::SsaaCmj:
+      return "ssaa-cmj:" + std::to_string(mode.samples);
     case ModeKind::Msaa:
       return "msaa:" + std::to_string(mode.samples);
     case ModeKind::Reference:

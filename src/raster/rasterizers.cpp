@@ -14,9 +14,9 @@ std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int
     case ModeKind::CoverageBlend:
       return make_coverage_rasterizer(tile_px, true);
     case ModeKind::Ssaa:
-      return make_ssaa_rasterizer(tile_px, mode.samples, false);
     case ModeKind::SsaaGrid:
-      return make_ssaa_rasterizer(tile_px, mode.samples, true);
+    case ModeKind::SsaaCmj:
+      return make_ssaa_rasterizer(tile_px, mode);
     case ModeKind::Msaa:
       return make_msaa_rasterizer(tile_px, mode.samples);
     case ModeKind::Reference:
