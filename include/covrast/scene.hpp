@@ -43,6 +43,10 @@ struct MeshData {
   /// +1: closed, consistently oriented, counter-clockwise faces point outwards; -1: the same
   /// with clockwise faces outwards; 0: not (known to be) closed.
   int closed_orientation = 0;
+  /// Closed as above, and convex: every vertex on or behind the plane of every face (tested
+  /// for meshes of up to kMaxConvexTestVertices vertices; larger ones stay false). The faces
+  /// of one facing of a convex mesh never overlap on screen, which the coverage mode uses.
+  bool convex = false;
   glm::vec3 bounds_min{0.0f};  ///< object-space box of the vertices the triangles use
   glm::vec3 bounds_max{0.0f};
   /// triangle_count() when analysed: the renderer ignores closed_orientation if the indices
@@ -57,6 +61,9 @@ struct MeshData {
 /// (that sign is closed_orientation). O(n log n) in the triangle count; call it on meshes built
 /// in code to enable culling for them.
 void analyze_mesh_topology(MeshData& mesh);
+/// Largest vertex count analyze_mesh_topology tests for convexity (the test is O(faces x
+/// vertices)).
+inline constexpr std::size_t kMaxConvexTestVertices = 4096;
 
 enum class ColorSource {
   Uniform,      ///< MeshInstance::color_linear for every triangle

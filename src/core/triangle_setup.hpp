@@ -39,6 +39,9 @@ struct TriangleSetup {
   std::uint32_t surface;    ///< mesh instance index: fragments of one surface may merge
   bool front_facing;        ///< counter-clockwise in NDC (OpenGL convention)
   bool flat_color;          ///< color[0] == color[1] == color[2]
+  /// Of a convex mesh under an affine model matrix: triangles of one surface and facing with
+  /// this flag never overlap on screen (the A-buffer skips their overlap test).
+  bool convex_surface;
 
   double depth_at(double x_px, double y_px) const {
     return z0 + dzdx * (x_px - x_fx8[0] * (1.0 / kSubpixelOne)) +

@@ -209,6 +209,14 @@ unsigned GeometryFrontEnd::drop_facing(std::size_t instance) const {
   return (codes & kNearFarBits) != 0 ? 0 : facing;
 }
 
+bool GeometryFrontEnd::convex_surface(std::size_t instance) const {
+  const MeshInstance& inst = scene_.meshes[instance];
+  const MeshData& mesh = *inst.mesh;
+  const glm::dmat4& m = inst.model;
+  return mesh.convex && mesh.analyzed_triangle_count == mesh.triangle_count() && m[0][3] == 0.0 &&
+         m[1][3] == 0.0 && m[2][3] == 0.0 && m[3][3] == 1.0;
+}
+
 std::size_t GeometryFrontEnd::vertex_count(std::size_t instance) const {
   return scene_.meshes[instance].mesh->positions.size();
 }
@@ -363,6 +371,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const InstanceVertices& iv = vertices_[instance];
     const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
+    sink.convex_surface = convex_surface(instance);
     const std::uint32_t* indices = inst.mesh->indices.data() + (g - first_triangle_[instance]) * 3;
     // A uniform colour is flat unless it is NaN (the per-triangle comparison's result).
     const glm::vec3 uniform = inst.color_linear;
@@ -488,6 +497,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.surface = surface;
   t.front_facing = front;
   t.flat_color = flat;
+  t.convex_surface = sink.convex_surface;
 }
 
 void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp,

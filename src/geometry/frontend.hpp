@@ -160,6 +160,7 @@ class GeometryFrontEnd {
     /// Facings dropped as hidden back faces for the current instance: kDropClockwise,
     /// kDropCounterClockwise or 0.
     unsigned drop_facing = 0;
+    bool convex_surface = false;  ///< the instance's TriangleSetup::convex_surface
     /// A new triangle at the end of the output, its fields to be written.
     TriangleSetup& next() { return chunk != nullptr ? chunk->emplace_back() : out->emplace_back(); }
   };
@@ -173,6 +174,11 @@ class GeometryFrontEnd {
   void setup_range(std::uint32_t chunk, Sink& sink) const;
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
+  /// Whether an instance's triangles are of a convex surface (TriangleSetup::convex_surface):
+  /// its mesh is convex (current analysis) and its model matrix affine, which keeps it convex;
+  /// its faces of one facing then cover each point of the screen at most once, from any eye
+  /// (clipping only cuts them smaller).
+  bool convex_surface(std::size_t instance) const;
   /// Conditions (a) and (b) (see frontend.cpp): the facing to drop if no vertex is clipped by
   /// the near or far plane, or 0.
   static unsigned cullable_facing(const MeshInstance& instance, const glm::dvec3& eye);

@@ -601,7 +601,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
   // the open set's sums give; resolve() takes those directly where it can).
   auto layer_color = [&](const bool* member) {
-    LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0};
+    LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
     for (int i = 0; i < n; ++i) {
       if (member != nullptr && !member[i]) continue;
       const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);

@@ -262,7 +262,14 @@ class ABufferTile {
     double rgb[3];           ///< sum of coverage * linear colour, in list order
     float depth;             ///< nearest centre depth
     double far;              ///< farthest depth any member reaches in the pixel
+    /// surface * 2 + front_facing when every member is of that one convex surface and facing
+    /// (their overlap tests are then known: none), else kNoConvexKey.
+    std::uint32_t convex_key;
   };
+  static constexpr std::uint32_t kNoConvexKey = 0xffffffffu;
+  static std::uint32_t convex_key(const TriangleSetup& t) {
+    return t.convex_surface ? t.surface * 2 + (t.front_facing ? 1u : 0u) : kNoConvexKey;
+  }
   /// Colour of a layer in front of everything else (abuffer.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
   std::vector<Layer> layer_;
@@ -385,10 +392,16 @@ inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const Tri
 
 inline bool ABufferTile::joins_open_set(std::size_t pixel, const TriangleSetup& t) const {
   if (open_count_[pixel] == 0) return true;
+  // Pieces of one convex surface and facing (TriangleSetup::convex_surface): no walk.
+  const std::uint32_t key = convex_key(t);
+  if (key != kNoConvexKey && layer_sums_[pixel].convex_key == key) return true;
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     if (!(pool_[f].coverage & kOpenFlag)) continue;
     if (!(pool_[f].coverage & kMergedFlag)) {
-      if (!interiors_disjoint(t, *pool_[f].triangle)) return false;
+      const TriangleSetup& m = *pool_[f].triangle;
+      // One facing of one convex surface: disjoint without a test (TriangleSetup).
+      if (t.convex_surface && m.surface == t.surface && m.front_facing == t.front_facing) continue;
+      if (!interiors_disjoint(t, m)) return false;
       continue;
     }
     const TriangleSetup* const* pieces;
@@ -409,6 +422,9 @@ inline void ABufferTile::add_to_sums(std::size_t pixel, int x, int y, const Tria
     sums.rgb[0] = sums.rgb[1] = sums.rgb[2] = 0.0;
     sums.depth = std::numeric_limits<float>::infinity();
     sums.far = -std::numeric_limits<double>::infinity();
+    sums.convex_key = convex_key(t);
+  } else if (sums.convex_key != convex_key(t)) {
+    sums.convex_key = kNoConvexKey;
   }
   const glm::vec3 c = shade(t, x + 0.5, y + 0.5, true);
   sums.coverage += coverage;
