@@ -116,9 +116,11 @@ GLTF_VARIANTS = [
 MODEL_SIZE = (640, 360)
 
 # Headline checks: coverage must be no slower than TIME_RIVAL, and against the reference have
-# an RMSE of at most RMSE_FACTOR x QUALITY_RIVAL's and a largest error no worse than its.
+# an RMSE of at most RMSE_FACTOR x the best QUALITY_RIVALS' and a largest error no worse than
+# the best of theirs (each measure taken from whichever 256-sample pattern does better).
 TIME_RIVAL = "msaa:4"
-QUALITY_RIVAL = "ssaa:16"
+QUALITY_RIVALS = ["ssaa:16", "ssaa-cmj:16"]
+QUALITY_RIVAL = "best ssaa:16/ssaa-cmj:16"
 RMSE_FACTOR = 0.7
 
 
@@ -728,12 +730,17 @@ def scene_checks(r):
     "time", "rmse", "max" and "quality", True, False or None (a row it needs is missing or
     failed):
       time:    coverage's time <= TIME_RIVAL's (both at the scene's timed size);
-      rmse:    coverage's RMSE <= RMSE_FACTOR x QUALITY_RIVAL's RMSE (against the reference);
-      max:     coverage's largest channel error <= QUALITY_RIVAL's;
+      rmse:    coverage's RMSE <= RMSE_FACTOR x the lowest RMSE of QUALITY_RIVALS (against the
+               reference);
+      max:     coverage's largest channel error <= the lowest of QUALITY_RIVALS';
       quality: rmse and max."""
     rows = r["rows"]
     cov = rows.get("coverage", {})
-    fast, fine = rows.get(TIME_RIVAL, {}), rows.get(QUALITY_RIVAL, {})
+    fast = rows.get(TIME_RIVAL, {})
+    rivals = [rows.get(name, {}) for name in QUALITY_RIVALS]
+    fine = ({"rmse": min(x["rmse"] for x in rivals),
+             "max_diff": min(x["max_diff"] for x in rivals)}
+            if all(ok(x) for x in rivals) else {"error": "a 256-sample mode failed"})
     timed = "error" not in cov and "ms" in cov and "error" not in fast and "ms" in fast
     compared = ok(cov) and ok(fine)
     check = {"time": None, "rmse": None, "max": None, "quality": None,

@@ -297,3 +297,26 @@ TEST_CASE("coverage modes: window depth stays in [0, 1] for slivers", "[coverage
     CHECK(*hi <= 1.0f);
   }
 }
+
+TEST_CASE("mesh topology: convex meshes are recognised, others are not", "[coverage][exact]") {
+  auto analysed = [](std::shared_ptr<MeshData> m) {
+    covrast::analyze_mesh_topology(*m);
+    return m;
+  };
+  CHECK(analysed(covrast::test::uv_sphere(24, 48))->convex);
+  // The same sphere dented (a fold), open (one triangle removed), and as two copies in one
+  // mesh: closed or not, none is convex.
+  CHECK_FALSE(analysed(folded_sphere(24, 48, 0.12))->convex);
+  auto open = covrast::test::uv_sphere(24, 48);
+  open->indices.resize(open->indices.size() - 3);
+  CHECK_FALSE(analysed(open)->convex);
+  auto twice = covrast::test::uv_sphere(12, 24);
+  const std::size_t n = twice->positions.size();
+  for (std::size_t i = 0; i < n; ++i) twice->positions.push_back(twice->positions[i] + 3.0f);
+  const std::size_t k = twice->indices.size();
+  for (std::size_t i = 0; i < k; ++i)
+    twice->indices.push_back(twice->indices[i] + std::uint32_t(n));
+  const auto both = analysed(twice);
+  CHECK(both->closed_orientation != 0);
+  CHECK_FALSE(both->convex);
+}
