@@ -123,6 +123,19 @@ FrontLayer find_front_layer(int n, const DepthRange* range, const std::uint32_t*
   return layer;
 }
 
+/// Whether `far` is behind `near` all over pixel (x, y): farther or level at its four corners
+/// (the planes are affine), and not the same plane drawn earlier (equal depth keeps the
+/// earlier triangle, as the samples do).
+bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near, int x, int y) {
+  const CornerDepths f = corner_depths(far, x, y), n = corner_depths(near, x, y);
+  int level = 0;
+  for (int k = 0; k < 4; ++k) {
+    if (f.z[k] < n.z[k]) return false;
+    level += f.z[k] == n.z[k];
+  }
+  return level < 4 || near.primitive < far.primitive;
+}
+
 /// The triangles each fragment of a pixel stands for: itself, or a merged fragment's
 /// pieces (count -1: not known).
 struct FragmentPieces {
@@ -194,7 +207,8 @@ double polygon_area(const ClipPolygon& poly) {
 /// opaque plane `o`: the pixel square clipped by t's three edges, then by the line where the
 /// planes meet (both affine, so the line is straight), by exact polygon clipping in double.
 /// Negative when t's part is too thin to measure.
-double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int y) {
+/// The part of pixel (x, y) inside triangle `t`: the pixel square clipped by its three edges.
+ClipPolygon part_in_pixel(const TriangleSetup& t, int x, int y) {
   ClipPolygon poly;
   const double px[4] = {double(x), double(x + 1), double(x + 1), double(x)};
   const double py[4] = {double(y), double(y), double(y + 1), double(y + 1)};
@@ -212,6 +226,24 @@ double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int 
     const double dx = t.x_fx8[j] * s - xi, dy = t.y_fx8[j] * s - yi;
     clip_half_plane(poly, dy * xi - dx * yi, -dy, dx);
   }
+  return poly;
+}
+
+/// The vertex average of a convex polygon (a point inside it) [pixels]; false when empty.
+bool inner_point(const ClipPolygon& poly, double& px, double& py) {
+  if (poly.n == 0) return false;
+  px = py = 0.0;
+  for (int i = 0; i < poly.n; ++i) {
+    px += poly.x[i];
+    py += poly.y[i];
+  }
+  px /= poly.n;
+  py /= poly.n;
+  return true;
+}
+
+double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int y) {
+  ClipPolygon poly = part_in_pixel(t, x, y);
   const double inside = polygon_area(poly);
   if (!(inside > 1e-12)) return -1.0;
   // Nearer where d = z_o - z_t > 0; d is affine: d(p) = d0 + ddx x + ddy y.
@@ -523,9 +555,24 @@ void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
     layer_[pixel] = Layer::One;  // nothing else to hide; the sums are the closed set's
     return;
   }
+  // The fragments stored before the set completed: each is earlier than some members, so
+  // it must be strictly behind (a level plane keeps the earlier triangle), and the depth
+  // bound of earlier closed sets does not apply to it (it may be one of their members).
+  const double far = layer_sums_[pixel].far;
   remove_fragments(pixel, [&](const Fragment& f) {
     if (f.coverage & kClosedFlag) return false;
-    return hidden_by_closed_set(pixel, x, y, *f.triangle, f.triangle->depth_at(x + 0.5, y + 0.5));
+    const TriangleSetup& t = *f.triangle;
+    if (t.depth_at(x + 0.5, y + 0.5) - depth_reach(t) > far) return true;
+    for (std::uint32_t g = head_[pixel]; g != kEnd; g = pool_[g].next) {
+      if (!(pool_[g].coverage & kClosedFlag)) continue;
+      const TriangleSetup* const* pieces;
+      const int count = fragment_pieces(g, pieces);
+      for (int k = 0; k < count; ++k) {
+        const TriangleSetup& m = *pieces[k];
+        if (!interiors_disjoint(t, m) && !behind_all_over(t, m, x, y)) return false;
+      }
+    }
+    return true;
   });
   if (count_[pixel] == closed_count_[pixel]) {
     layer_[pixel] = Layer::One;  // the sums are the closed set's
@@ -746,9 +793,17 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
       share = 1.0;  // nothing in front of it overlaps it: its whole area shows
     } else if (samples > 0) {
       share = double(won[i + 1]) / samples;
+    } else if (double px, py;
+               merged[i] == nullptr && inner_point(part_in_pixel(*tri[i], x, y), px, py)) {
+      // Too thin to own a sample: visible or not where it is, at the sample nearest to a
+      // point inside its part of the pixel (its plane against that sample's winner).
+      const int si = std::clamp(int((px - x) * kMaskGridSide), 0, kMaskGridSide - 1);
+      const int sj = std::clamp(int((py - y) * kMaskGridSide), 0, kMaskGridSide - 1);
+      const SamplePlane plane(*tri[i], x, y);
+      share = plane.at(plane.row(sj), si) < best_z[sj * kMaskGridSide + si] ? 1.0 : 0.0;
     } else {
-      // Too small to own a sample: spread it over the pixel, and count the samples where
-      // its plane would be nearer than what won them.
+      // A merged piece without samples: spread it over the pixel, and count the samples
+      // where its plane would be nearer than what won them.
       const SamplePlane plane(*tri[i], x, y);
       int nearer = 0;
       for (int j = 0; j < kMaskGridSide; ++j) {
@@ -763,22 +818,7 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
   }
 }
 
-namespace {
-
-/// Whether `far` is behind `near` all over pixel (x, y): farther or level at its four corners
-/// (the planes are affine), and not the same plane drawn earlier (equal depth keeps the
-/// earlier triangle, as the samples do).
-bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near, int x, int y) {
-  const CornerDepths f = corner_depths(far, x, y), n = corner_depths(near, x, y);
-  int level = 0;
-  for (int k = 0; k < 4; ++k) {
-    if (f.z[k] < n.z[k]) return false;
-    level += f.z[k] == n.z[k];
-  }
-  return level < 4 || near.primitive < far.primitive;
-}
-
-}  // namespace
+namespace {}  // namespace
 
 void ABufferTile::unhidden_fragments(int x, int y, const TriangleSetup* opaque, int n,
                                      const TriangleSetup* const* tri,
