@@ -25,30 +25,16 @@
 #include <string>
 #include <vector>
 
+#include "test_tempdir.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
 
-class TempDir {
+/// A temporary directory of this file's tests.
+class TempDir : public covrast::test::TempDir {
  public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = fs::temp_directory_path() / ("covrast-test-image-" + std::to_string(::getpid()) + "-" +
-                                         std::to_string(ticks) + "-" + std::to_string(counter++));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-
- private:
-  fs::path path_;
+  TempDir() : covrast::test::TempDir("covrast-test-image") {}
 };
 
 std::string read_bytes(const fs::path& path) {

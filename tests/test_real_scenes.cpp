@@ -26,30 +26,17 @@
 #include <map>
 #include <string>
 
+#include "test_tempdir.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
 using namespace covrast;
 
-/// A fresh directory under the system temp directory, removed on destruction.
-class TempDir {
+/// A temporary directory of this file's tests.
+class TempDir : public covrast::test::TempDir {
  public:
-  TempDir() {
-    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = fs::temp_directory_path() / ("covrast_test_real_" + std::to_string(ticks) + "_" +
-                                         std::to_string(reinterpret_cast<std::uintptr_t>(this)));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
+  TempDir() : covrast::test::TempDir("covrast-test-real") {}
 };
 
 /// Runs `covrast-scenegen --real DIR` with the given extra arguments; returns std::system's

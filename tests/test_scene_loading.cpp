@@ -21,6 +21,8 @@
 
 #include <unistd.h>
 
+#include "test_tempdir.hpp"
+
 namespace fs = std::filesystem;
 using Catch::Matchers::Contains;
 using covrast::ColorSource;
@@ -31,24 +33,12 @@ using nlohmann::json;
 namespace {
 
 /// A fresh directory under the system temp dir, removed again at scope exit.
-class TempDir {
+class TempDir : public covrast::test::TempDir {
  public:
-  TempDir() {
-    static std::atomic<int> counter{0};
-    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = fs::temp_directory_path() / ("covrast_scene_test_" + std::to_string(::getpid()) + "_" +
-                                         std::to_string(counter++) + "_" + std::to_string(ticks));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ec;
-    fs::remove_all(path_, ec);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
+  TempDir() : covrast::test::TempDir("covrast-test-scene") {}
 
   fs::path write(const std::string& name, const std::string& contents) const {
-    const fs::path file = path_ / name;
+    const fs::path file = path() / name;
     fs::create_directories(file.parent_path());
     std::ofstream out(file, std::ios::binary);
     out << contents;
@@ -57,10 +47,6 @@ class TempDir {
   fs::path write_json(const std::string& name, const json& value) const {
     return write(name, value.dump(2));
   }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
 };
 
 /// The message of the InputError that loading `scene` throws; fails the test if none is thrown.

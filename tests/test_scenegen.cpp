@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "test_tempdir.hpp"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -32,25 +34,10 @@ const std::set<std::string> kGeneratedFiles = {
     "sphere_grid.json", "overlap.json",       "sphere.obj", "sphere5k.obj", "fan.obj",
     "box.obj",          "big_tri.obj",        "tri.obj"};
 
-/// A fresh directory under the system temp directory, removed on destruction.
-class TempDir {
+/// A temporary directory of this file's tests.
+class TempDir : public covrast::test::TempDir {
  public:
-  TempDir() {
-    const auto ticks = std::chrono::steady_clock::now().time_since_epoch().count();
-    path_ = fs::temp_directory_path() / ("covrast_test_scenegen_" + std::to_string(ticks) + "_" +
-                                         std::to_string(reinterpret_cast<std::uintptr_t>(this)));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  TempDir(const TempDir&) = delete;
-  TempDir& operator=(const TempDir&) = delete;
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
+  TempDir() : covrast::test::TempDir("covrast-test-scenegen") {}
 };
 
 /// Runs the generator with the given arguments after OUT_DIR; returns std::system's status.
