@@ -136,8 +136,7 @@ bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near, int x,
   return level < 4 || near.primitive < far.primitive;
 }
 
-/// The triangles each fragment of a pixel stands for: itself, or a merged fragment's
-/// pieces (count -1: not known).
+/// The triangles each fragment of a pixel stands for: itself, or a merged fragment's pieces.
 struct FragmentPieces {
   const TriangleSetup* const* piece;
   int count;
@@ -145,7 +144,6 @@ struct FragmentPieces {
 
 /// Whether two fragments' triangles have pairwise disjoint interiors (triangle_overlap.hpp).
 bool fragments_disjoint(FragmentPieces a, FragmentPieces b) {
-  if (a.count < 0 || b.count < 0) return false;
   for (int i = 0; i < a.count; ++i) {
     for (int j = 0; j < b.count; ++j) {
       if (!interiors_disjoint(*a.piece[i], *b.piece[j])) return false;
@@ -159,7 +157,6 @@ bool fragments_disjoint(FragmentPieces a, FragmentPieces b) {
 bool pieces_disjoint(int n, const FragmentPieces* pieces, const bool* member) {
   for (int i = 0; i < n; ++i) {
     if (member != nullptr && !member[i]) continue;
-    if (pieces[i].count < 0) return false;
     for (int j = i + 1; j < n; ++j) {
       if (member != nullptr && !member[j]) continue;
       if (!fragments_disjoint(pieces[i], pieces[j])) return false;
@@ -515,24 +512,6 @@ void ABufferTile::remove_fragments(std::size_t pixel, Drop drop) {
   tail_[pixel] = last;
 }
 
-bool ABufferTile::hidden_by_closed_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
-                                       double centre_z) const {
-  if (centre_z - depth_reach(t) >= occluder_z_[pixel]) return true;
-  // The closed set covers the pixel, so every point of t's part of it lies in a member that
-  // t overlaps: t is hidden when it is behind (or level with, being later) each of those.
-  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
-    if (!(pool_[f].coverage & kClosedFlag)) continue;
-    const TriangleSetup* const* pieces;
-    const int count = fragment_pieces(f, pieces);
-    if (count < 0) return false;
-    for (int k = 0; k < count; ++k) {
-      const TriangleSetup& m = *pieces[k];
-      if (!interiors_disjoint(t, m) && order_of(t, m, x, y) != DepthOrder::Behind) return false;
-    }
-  }
-  return true;
-}
-
 bool ABufferTile::hidden_by_container(std::size_t pixel, int x, int y,
                                       const TriangleSetup& t) const {
   // Copies of one triangle arrive one after the other (one mesh, or instances in order), so
@@ -551,29 +530,19 @@ void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
   }
   closed_count_[pixel] = open_count_[pixel];
   open_count_[pixel] = 0;
-  if (count_[pixel] == closed_count_[pixel]) {
-    layer_[pixel] = Layer::One;  // nothing else to hide; the sums are the closed set's
-    return;
+  if (count_[pixel] != closed_count_[pixel]) {
+    // The fragments stored before the set completed: each is earlier than some members, so
+    // it must be strictly behind (a level plane keeps the earlier triangle), and the depth
+    // bound of earlier closed sets does not apply to it (it may be one of their members).
+    const double far = layer_sums_[pixel].far;
+    remove_fragments(pixel, [&](const Fragment& f) {
+      if (f.coverage & kClosedFlag) return false;
+      const TriangleSetup& t = *f.triangle;
+      if (t.depth_at(x + 0.5, y + 0.5) - depth_reach(t) > far) return true;
+      return behind_closed_set(pixel, t,
+                               [&](const TriangleSetup& m) { return behind_all_over(t, m, x, y); });
+    });
   }
-  // The fragments stored before the set completed: each is earlier than some members, so
-  // it must be strictly behind (a level plane keeps the earlier triangle), and the depth
-  // bound of earlier closed sets does not apply to it (it may be one of their members).
-  const double far = layer_sums_[pixel].far;
-  remove_fragments(pixel, [&](const Fragment& f) {
-    if (f.coverage & kClosedFlag) return false;
-    const TriangleSetup& t = *f.triangle;
-    if (t.depth_at(x + 0.5, y + 0.5) - depth_reach(t) > far) return true;
-    for (std::uint32_t g = head_[pixel]; g != kEnd; g = pool_[g].next) {
-      if (!(pool_[g].coverage & kClosedFlag)) continue;
-      const TriangleSetup* const* pieces;
-      const int count = fragment_pieces(g, pieces);
-      for (int k = 0; k < count; ++k) {
-        const TriangleSetup& m = *pieces[k];
-        if (!interiors_disjoint(t, m) && !behind_all_over(t, m, x, y)) return false;
-      }
-    }
-    return true;
-  });
   if (count_[pixel] == closed_count_[pixel]) {
     layer_[pixel] = Layer::One;  // the sums are the closed set's
     return;

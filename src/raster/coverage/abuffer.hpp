@@ -69,11 +69,11 @@ inline double depth_reach(const TriangleSetup& t) {
 /// How one triangle's depth plane lies against another's over a pixel.
 enum class DepthOrder { InFront, Behind, Crossing };
 
-/// Adjacent pieces of a conforming tessellation share a vertex (an edge, or a fan's centre).
-/// A fold of one mesh over itself shares none with what it covers, or, folded over a shared
-/// edge, has the opposite facing. It runs for every fragment (the one-layer test), so it
-/// compares b's vertices with all of a's at once, in 4-lane integer vectors (GCC/Clang vector
-/// extensions: SSE2 on x86-64, NEON on Arm), without a branch per pair.
+/// Whether two triangles share a vertex: neighbours in a tessellation do (an edge, or a
+/// fan's centre). It groups fragments into a front layer and picks merge partners; it proves
+/// nothing about overlap (triangle_overlap.hpp does). b's vertices are compared with all of
+/// a's at once, in 4-lane integer vectors (GCC/Clang vector extensions: SSE2 on x86-64, NEON
+/// on Arm), without a branch per pair.
 inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
   using Lanes = std::int32_t __attribute__((vector_size(16)));
   // a's x0 x1 x2 and y0 y1 y2 (the fourth lane is the next member's bytes, masked out below).
@@ -191,9 +191,11 @@ class ABufferTile {
   /// The open set's areas fill the pixel: it becomes the closed set (the pixel's occluder),
   /// the fragments it hides leave the list, and a new open set is started from the rest.
   void complete_open_set(std::size_t pixel, int x, int y);
-  /// Whether the pixel's closed set hides `t` everywhere in the pixel (see closed sets).
-  bool hidden_by_closed_set(std::size_t pixel, int x, int y, const TriangleSetup& t,
-                            double centre_z) const;
+  /// Whether `behind(m)` holds for every triangle m of the pixel's closed set that `t`
+  /// overlaps. The closed set covers the pixel, so every point of t's part of it lies in such
+  /// an m: t is hidden there when it is behind each of them.
+  template <class Behind>
+  bool behind_closed_set(std::size_t pixel, const TriangleSetup& t, Behind behind) const;
   /// Whether the newest stored fragment is a single triangle that contains `t` and is nearer
   /// than or level with it all over the pixel (so t, being later, shows nowhere): many copies
   /// of one triangle.
@@ -252,9 +254,10 @@ class ABufferTile {
   std::vector<std::uint32_t> head_;           ///< per pixel, first fragment (newest last)
   std::vector<std::uint32_t> tail_;           ///< per pixel, last fragment
   std::vector<std::uint8_t> count_;           ///< per pixel, fragments in the list
-  /// Per pixel: Empty (no fragments), One (every fragment is in the open set, so they are
-  /// pairwise disjoint and layer_sums_ describes them all), Mixed, or Sampled (the list
-  /// has merged or dropped fragments: no sets are kept, only the list knows).
+  /// Per pixel: Empty (no fragments), One (every fragment is in the open set, or in the
+  /// closed set and nothing else is stored: they are pairwise disjoint and layer_sums_
+  /// describes them all), Mixed, or Sampled (the list overflowed into samples_; no list and
+  /// no sets are kept).
   enum class Layer : std::uint8_t { Empty, One, Mixed, Sampled };
   /// Running sums of the pixel's open set, or of its closed set while that is all there is.
   struct LayerSums {
@@ -323,7 +326,12 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
                              double centre_z) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
   if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set
-  if (closed_count_[pixel] != 0 && hidden_by_closed_set(pixel, x, y, *t, centre_z)) return;
+  // Hidden by the closed set: behind (or level with, being later) every member it overlaps.
+  if (closed_count_[pixel] != 0 && behind_closed_set(pixel, *t, [&](const TriangleSetup& m) {
+        return order_of(*t, m, x, y) == DepthOrder::Behind;
+      })) {
+    return;
+  }
   if (layer_[pixel] == Layer::Sampled) {
     // The opaque surface is in the samples already; a full triangle goes there too.
     if (opaque_[pixel] != nullptr &&
@@ -390,6 +398,20 @@ inline void ABufferTile::add_fragment(std::size_t pixel, int x, int y, const Tri
   if (layer_sums_[pixel].coverage >= std::uint32_t(kCoverageOne)) complete_open_set(pixel, x, y);
 }
 
+template <class Behind>
+bool ABufferTile::behind_closed_set(std::size_t pixel, const TriangleSetup& t,
+                                    Behind behind) const {
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kClosedFlag)) continue;
+    const TriangleSetup* const* pieces;
+    const int count = fragment_pieces(f, pieces);
+    for (int k = 0; k < count; ++k) {
+      if (!interiors_disjoint(t, *pieces[k]) && !behind(*pieces[k])) return false;
+    }
+  }
+  return true;
+}
+
 inline bool ABufferTile::joins_open_set(std::size_t pixel, const TriangleSetup& t) const {
   if (open_count_[pixel] == 0) return true;
   // Pieces of one convex surface and facing (TriangleSetup::convex_surface): no walk.
@@ -397,18 +419,13 @@ inline bool ABufferTile::joins_open_set(std::size_t pixel, const TriangleSetup& 
   if (key != kNoConvexKey && layer_sums_[pixel].convex_key == key) return true;
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     if (!(pool_[f].coverage & kOpenFlag)) continue;
-    if (!(pool_[f].coverage & kMergedFlag)) {
-      const TriangleSetup& m = *pool_[f].triangle;
+    const TriangleSetup* const* pieces;
+    const int count = fragment_pieces(f, pieces);
+    for (int k = 0; k < count; ++k) {
+      const TriangleSetup& m = *pieces[k];
       // One facing of one convex surface: disjoint without a test (TriangleSetup).
       if (t.convex_surface && m.surface == t.surface && m.front_facing == t.front_facing) continue;
       if (!interiors_disjoint(t, m)) return false;
-      continue;
-    }
-    const TriangleSetup* const* pieces;
-    const int count = fragment_pieces(f, pieces);
-    if (count < 0) return false;
-    for (int k = 0; k < count; ++k) {
-      if (!interiors_disjoint(t, *pieces[k])) return false;
     }
   }
   return true;

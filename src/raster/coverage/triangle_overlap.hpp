@@ -21,21 +21,6 @@
 
 namespace covrast::detail {
 
-/// Whether some edge line of `a` has all of `b` on its closed outer side.
-inline bool separated_by_edge_of(const TriangleSetup& a, const TriangleSetup& b) {
-  for (int i = 0; i < 3; ++i) {
-    const int j = i == 2 ? 0 : i + 1;
-    const std::int64_t xi = a.x_fx8[i], yi = a.y_fx8[i];
-    const std::int64_t dx = a.x_fx8[j] - xi, dy = a.y_fx8[j] - yi;
-    bool outside = true;
-    for (int k = 0; k < 3; ++k) {
-      outside &= dx * (b.y_fx8[k] - yi) - dy * (b.x_fx8[k] - xi) <= 0;
-    }
-    if (outside) return true;
-  }
-  return false;
-}
-
 /// Whether the edge i -> j of `a` has the vertices of `b` other than `skip` (-1: none) on
 /// its closed outer side.
 inline bool edge_separates(const TriangleSetup& a, int i, const TriangleSetup& b, int skip) {
@@ -47,6 +32,11 @@ inline bool edge_separates(const TriangleSetup& a, int i, const TriangleSetup& b
     if (k != skip) outside &= dx * (b.y_fx8[k] - yi) - dy * (b.x_fx8[k] - xi) <= 0;
   }
   return outside;
+}
+
+/// Whether some edge line of `a` has all of `b` on its closed outer side.
+inline bool separated_by_edge_of(const TriangleSetup& a, const TriangleSetup& b) {
+  return edge_separates(a, 0, b, -1) || edge_separates(a, 1, b, -1) || edge_separates(a, 2, b, -1);
 }
 
 /// Whether the interiors of `a` and `b` are disjoint (their overlap has zero area).
