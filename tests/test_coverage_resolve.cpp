@@ -627,6 +627,58 @@ TEST_CASE("coverage mode: more fragments than a pixel list holds keep their plac
   }
 }
 
+// Pixel (20, 20): red A covers x < 20.3 (nearest), green B x > 20.7, blue C y < 20.9
+// (farthest), over a black background. Exact linear colour: (0.3, 0.3, 0.36). With room for
+// two fragments, the third turns the pixel into 16 x 16 samples, whose counts alone give
+// (0.3125, 0.3125, 0.328): five of sixteen columns for A and B, 84 of 256 samples for C.
+TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of its winners",
+          "[coverage]") {
+  const FragmentCapacity capacity(2);
+  Scene s = make_scene(40, 40, glm::vec3(0));
+  add_instance(s, screen_mesh(s, {{20.3, 10.0, 0.6}, {20.3, 30.0, 0.6}, {10.0, 20.5, 0.6}}),
+               glm::vec3(1, 0, 0));
+  add_instance(s, screen_mesh(s, {{20.7, 10.0, 0.3}, {30.0, 20.5, 0.3}, {20.7, 30.0, 0.3}}),
+               glm::vec3(0, 1, 0));
+  add_instance(s, screen_mesh(s, {{10.0, 20.9, 0.0}, {20.5, 10.0, 0.0}, {31.0, 20.9, 0.0}}),
+               glm::vec3(0, 0, 1));
+  const auto result = render(s, ModeKind::Coverage);
+  CHECK(result.stats.fragment_overflows > 0);
+  const std::uint8_t* p = result.color.pixel(20, 20);
+  const glm::dvec3 got(covrast::srgb_to_linear(p[0] / 255.0f),
+                       covrast::srgb_to_linear(p[1] / 255.0f),
+                       covrast::srgb_to_linear(p[2] / 255.0f));
+  INFO("pixel (20, 20) linear (" << got.r << ", " << got.g << ", " << got.b
+                                 << "), exact (0.3, 0.3, 0.36)");
+  // A and B won every sample they own: their exact areas, scaled with C's estimate to fill
+  // what the background's 12 samples leave (0.305 each); C's share stays an estimate.
+  CHECK(std::fabs(got.r - 0.3) < 0.008);
+  CHECK(std::fabs(got.g - 0.3) < 0.008);
+  CHECK(std::fabs(got.b - 0.36) < 0.025);
+}
+
+// Two triangles folded over one another along a shared edge at y = 20.98: each covers the
+// strip y > 20.98 of pixel (20, 20), 2% of it and below its last row of samples (y = 20.97),
+// so neither owns a sample. Only the nearer (green) may show there, not both.
+TEST_CASE("coverage mode: slivers too thin for a sample still hide one another", "[coverage]") {
+  Scene s = make_scene(40, 40, glm::vec3(0));
+  const std::vector<ScreenVertex> folded = {{8.0, 20.98, 0.5},  {32.0, 20.98, 0.5},
+                                            {20.0, 32.0, 0.0},  {8.0, 20.98, 0.5},
+                                            {32.0, 20.98, 0.5}, {20.0, 30.0, 1.0}};
+  add_instance(s,
+               screen_mesh(s, folded,
+                           {glm::vec3(1, 0, 0), glm::vec3(1, 0, 0), glm::vec3(1, 0, 0),
+                            glm::vec3(0, 1, 0), glm::vec3(0, 1, 0), glm::vec3(0, 1, 0)}),
+               glm::vec3(1), ColorSource::Vertex);
+  const auto result = render(s, ModeKind::Coverage);
+  const std::uint8_t* p = result.color.pixel(20, 20);
+  const double red = covrast::srgb_to_linear(p[0] / 255.0f);
+  const double green = covrast::srgb_to_linear(p[1] / 255.0f);
+  INFO("pixel (20, 20) = (" << int(p[0]) << ", " << int(p[1]) << ", " << int(p[2]) << ")");
+  CHECK(red < 0.002);
+  CHECK(green > 0.01);
+  CHECK(green < 0.03);
+}
+
 TEST_CASE("coverage mode: a silhouette blends with the surface behind it", "[coverage]") {
   // Front green triangle (depth 0.5) over a large blue quad (depth 0) whose diagonal crosses
   // the green edges; background black. The edges must mix green and blue only. Where the

@@ -194,9 +194,7 @@ TEST_CASE("real-content decals: coverage closer to the reference than ssaa:16", 
 }
 
 // 128x72: at 160x90 the reference alone takes about 12 s here (long thin triangles).
-// Known failure: see the note above pleated_sheet.
-TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16",
-          "[real][!shouldfail]") {
+TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16", "[real]") {
   check_real_scene("cad_assembly", 128, 72);
 }
 

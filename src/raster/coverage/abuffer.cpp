@@ -575,6 +575,26 @@ bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const Trian
   return true;
 }
 
+namespace {
+
+/// Sample shares (won / owned) are quantised: a sliver of the next layer that shows along an
+/// edge of the front one is mostly missed by the samples, and what they miss would go to the
+/// opaque surface or the background behind, which may be hidden there. So the weights that
+/// are estimates (`estimated`) are scaled together to fill what the exact ones leave, less
+/// the share of the samples that the surface behind won; each stays within its own coverage.
+void fill_estimated_share(int n, const std::uint32_t* cov, const bool* estimated,
+                          double behind_share, double* weight) {
+  double exact = 0.0, estimate = 0.0;
+  for (int i = 0; i < n; ++i) (estimated[i] ? estimate : exact) += weight[i];
+  if (!(estimate > 0.0)) return;
+  const double scale = std::max(0.0, 1.0 - exact - behind_share) / estimate;
+  for (int i = 0; i < n; ++i) {
+    if (estimated[i]) weight[i] = std::min(weight[i] * scale, double(cov[i]) / kCoverageOne);
+  }
+}
+
+}  // namespace
+
 glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
                                      float& depth) {
   const double cx = x + 0.5, cy = y + 0.5;
@@ -594,19 +614,29 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     const TriangleSetup* t = pool_[f].triangle;
     const double centre_z = t->depth_at(cx, cy);
-    const DepthRange r = range_around(*t, centre_z);
-    if (opaque != nullptr) {
-      DepthOrder order = r.max < opaque_range.min    ? DepthOrder::InFront
-                         : r.min >= opaque_range.max ? DepthOrder::Behind
-                                                     : order_of(*t, *opaque, x, y);
-      if (order == DepthOrder::Behind) continue;  // hidden: the opaque surface came later
-      if (order == DepthOrder::Crossing) crossing = true;
+    pieces[n].count = fragment_pieces(f, pieces[n].piece);
+    // A merged fragment spans its pieces' planes: its range is their union, and it is
+    // behind the opaque surface only where every piece is.
+    DepthRange r{kFar, -kFar};
+    bool behind_opaque = opaque != nullptr, crosses_opaque = false;
+    for (int k = 0; k < pieces[n].count; ++k) {
+      const TriangleSetup& p = *pieces[n].piece[k];
+      const DepthRange pr =
+          &p == t ? range_around(p, centre_z) : range_around(p, p.depth_at(cx, cy));
+      r = {std::min(r.min, pr.min), std::max(r.max, pr.max)};
+      if (opaque == nullptr) continue;
+      const DepthOrder order = pr.max < opaque_range.min    ? DepthOrder::InFront
+                               : pr.min >= opaque_range.max ? DepthOrder::Behind
+                                                            : order_of(p, *opaque, x, y);
+      behind_opaque = behind_opaque && order == DepthOrder::Behind;
+      crosses_opaque = crosses_opaque || order == DepthOrder::Crossing;
     }
+    if (behind_opaque) continue;  // hidden: the opaque surface came later
+    crossing = crossing || crosses_opaque;
     tri[n] = t;
     const std::uint32_t c = pool_[f].coverage;
     cov[n] = c & kCoverageBits;
     merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
-    pieces[n].count = fragment_pieces(f, pieces[n].piece);
     range[n] = r;
     depth = std::min(depth, float(centre_z));
     ++n;
@@ -660,7 +690,9 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   if (share >= 0.0) {
     weight[0] = double(cov[0]) / kCoverageOne * share;
   } else {
-    sample_weights(x, y, opaque, n, tri, cov, merged, weight);
+    bool estimated[kMaxFragmentsPerPixel];
+    const int behind_samples = sample_weights(x, y, opaque, n, tri, cov, merged, weight, estimated);
+    fill_estimated_share(n, cov, estimated, double(behind_samples) / kMaskSamples, weight);
   }
   double total = 0;
   for (int i = 0; i < n; ++i) total += weight[i];
@@ -701,14 +733,64 @@ struct SamplePlane {
   double at(double row_z, int i) const { return row_z + dzdx * kSampleOffset[std::size_t(i)]; }
 };
 
+/// The fragment that took one of fragment i's samples (its mask `mine`; `best` holds each
+/// sample's winner plus one), or -1 when it won them all.
+int lost_to(const SampleMask& mine, const std::uint8_t* best, int i) {
+  for (int w = 0; w < 4; ++w) {
+    for (std::uint64_t bits = mine.word[w]; bits != 0; bits &= bits - 1) {
+      const int winner = best[w * 64 + std::countr_zero(bits)] - 1;
+      if (winner != i) return winner;
+    }
+  }
+  return -1;
+}
+
+/// Whether point p [pixels] lies inside or on the edges of `t`.
+bool covers_point(const TriangleSetup& t, double px, double py) {
+  const double s = 1.0 / kSubpixelOne;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i == 2 ? 0 : i + 1;
+    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
+    if ((t.x_fx8[j] * s - xi) * (py - yi) - (t.y_fx8[j] * s - yi) * (px - xi) < 0.0) return false;
+  }
+  return true;
+}
+
+/// Whether fragment i is the nearest at point p of its part of the pixel among the fragments
+/// that cover p (nearer, or level and earlier, than each). Samples cannot tell it for a
+/// fragment too thin to own one: two such slivers folded over one another along a shared
+/// edge own the same (no) samples and each would show.
+template <class Merged>
+bool nearest_at_point(int n, const TriangleSetup* const* tri, const Merged* const* merged, int i,
+                      double px, double py) {
+  const double z = tri[i]->depth_at(px, py);
+  auto hides = [&](const TriangleSetup& o) {
+    if (!covers_point(o, px, py)) return false;
+    const double oz = o.depth_at(px, py);
+    return oz < z || (oz == z && o.primitive < tri[i]->primitive);
+  };
+  for (int j = 0; j < n; ++j) {
+    if (j == i) continue;
+    if (merged[j] == nullptr) {
+      if (hides(*tri[j])) return false;
+      continue;
+    }
+    for (int k = 0; k < merged[j]->pieces; ++k) {
+      if (hides(*merged[j]->piece[k])) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 /// Visibility per sub-pixel sample, with per-sample depth from each plane: a fragment's
 /// weight is its coverage times the share of its samples where it is the nearest (equal
 /// depth keeps the earlier triangle). Only the samples a fragment owns are evaluated.
-void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n,
-                                 const TriangleSetup* const* tri, const std::uint32_t* cov,
-                                 const MergedPiece* const* merged, double* weight) const {
+int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n,
+                                const TriangleSetup* const* tri, const std::uint32_t* cov,
+                                const MergedPiece* const* merged, double* weight,
+                                bool* estimated) const {
   double best_z[kMaskSamples];
   std::uint32_t best_primitive[kMaskSamples];
   // Per sample, the fragment nearest so far plus one (0: none); won[k + 1] counts the
@@ -729,39 +811,55 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
   std::fill(best_primitive, best_primitive + kMaskSamples,
             opaque != nullptr ? opaque->primitive : kNoTriangle);
   std::memset(best, 0, sizeof(best));
-  SampleMask mask[kMaxFragmentsPerPixel];
-  for (int i = 0; i < n; ++i) {
-    mask[i] = merged[i] != nullptr ? merged[i]->mask : pixel_sample_mask(*tri[i], x, y);
-    const std::uint32_t primitive = tri[i]->primitive;
-    const SamplePlane plane(*tri[i], x, y);
+  // Samples `owned` of triangle `t`, for fragment i: nearest wins; equal depth keeps the
+  // earlier triangle. The (depth, primitive) order is total, so the winner does not depend
+  // on the order fragments are visited in.
+  auto depth_test = [&](const SampleMask& owned, const TriangleSetup& t, int i) {
+    const SamplePlane plane(t, x, y);
     for (int j = 0; j < kMaskGridSide; ++j) {
-      std::uint32_t bits = mask[i].row(j);
+      std::uint32_t bits = owned.row(j);
       if (bits == 0) continue;
       const double row_z = plane.row(j);
       for (; bits != 0; bits &= bits - 1) {
         const int k = std::countr_zero(bits), s = j * kMaskGridSide + k;
         const double z = plane.at(row_z, k);
-        // Nearest wins; equal depth keeps the earlier triangle. The (depth, primitive) order
-        // is total, so the winner does not depend on the order fragments are visited in.
-        if (z < best_z[s] || (z == best_z[s] && primitive < best_primitive[s])) {
+        if (z < best_z[s] || (z == best_z[s] && t.primitive < best_primitive[s])) {
           best_z[s] = z;
-          best_primitive[s] = primitive;
-          --won[best[s]];
-          ++won[i + 1];
+          best_primitive[s] = t.primitive;
           best[s] = std::uint8_t(i + 1);
         }
       }
     }
+  };
+  SampleMask mask[kMaxFragmentsPerPixel];
+  for (int i = 0; i < n; ++i) {
+    if (merged[i] == nullptr) {
+      mask[i] = pixel_sample_mask(*tri[i], x, y);
+      depth_test(mask[i], *tri[i], i);
+      continue;
+    }
+    // A merged fragment is the union of its pieces (disjoint members of one open set), each
+    // depth-tested with its own plane: one plane for all would misplace pieces that tilt
+    // differently, as the long slivers of CAD models do.
+    mask[i] = merged[i]->mask;
+    for (int k = 0; k < merged[i]->pieces; ++k) {
+      const TriangleSetup& piece = *merged[i]->piece[k];
+      depth_test(pixel_sample_mask(piece, x, y), piece, i);
+    }
   }
-  bool exact[kMaxFragmentsPerPixel];
-  unhidden_fragments(x, y, opaque, n, tri, merged, exact);
+  for (int s = 0; s < kMaskSamples; ++s) ++won[best[s]];
   for (int i = 0; i < n; ++i) {
     const int samples = mask[i].count();
     double share;
-    if (exact[i]) {
+    estimated[i] = false;
+    if (samples > 0 && won[i + 1] == samples) {
+      share = 1.0;  // it won all its samples: the same share as when nothing hides it
+    } else if (shows_whole(x, y, opaque, n, tri, merged, i,
+                           samples > 0 ? lost_to(mask[i], best, i) : -1)) {
       share = 1.0;  // nothing in front of it overlaps it: its whole area shows
     } else if (samples > 0) {
       share = double(won[i + 1]) / samples;
+      estimated[i] = true;
     } else if (double px, py;
                merged[i] == nullptr && inner_point(part_in_pixel(*tri[i], x, y), px, py)) {
       // Too thin to own a sample: visible or not where it is, at the sample nearest to a
@@ -769,7 +867,10 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
       const int si = std::clamp(int((px - x) * kMaskGridSide), 0, kMaskGridSide - 1);
       const int sj = std::clamp(int((py - y) * kMaskGridSide), 0, kMaskGridSide - 1);
       const SamplePlane plane(*tri[i], x, y);
-      share = plane.at(plane.row(sj), si) < best_z[sj * kMaskGridSide + si] ? 1.0 : 0.0;
+      share = plane.at(plane.row(sj), si) < best_z[sj * kMaskGridSide + si] &&
+                      nearest_at_point(n, tri, merged, i, px, py)
+                  ? 1.0
+                  : 0.0;
     } else {
       // A merged piece without samples: spread it over the pixel, and count the samples
       // where its plane would be nearer than what won them.
@@ -782,27 +883,30 @@ void ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int 
         }
       }
       share = nearer / double(kMaskSamples);
+      estimated[i] = true;
     }
     weight[i] = double(cov[i]) / kCoverageOne * share;
   }
+  return won[0];
 }
 
-namespace {}  // namespace
-
-void ABufferTile::unhidden_fragments(int x, int y, const TriangleSetup* opaque, int n,
-                                     const TriangleSetup* const* tri,
-                                     const MergedPiece* const* merged, bool* exact) {
+bool ABufferTile::shows_whole(int x, int y, const TriangleSetup* opaque, int n,
+                              const TriangleSetup* const* tri, const MergedPiece* const* merged,
+                              int i, int suspect) {
   constexpr int kMaxPairs = 32;  // beyond it, n^2 tests cost more than they can save
-  for (int i = 0; i < n; ++i) {
-    bool alone = n <= kMaxPairs && merged[i] == nullptr &&
-                 (opaque == nullptr || behind_all_over(*opaque, *tri[i], x, y));
-    for (int j = 0; j < n && alone; ++j) {
-      if (j == i) continue;
-      alone = (merged[j] == nullptr && interiors_disjoint(*tri[i], *tri[j])) ||
-              behind_all_over(*tri[j], *tri[i], x, y);
-    }
-    exact[i] = alone;
+  if (n > kMaxPairs || merged[i] != nullptr) return false;
+  if (opaque != nullptr && !behind_all_over(*opaque, *tri[i], x, y)) return false;
+  // Every other fragment misses it (a separating edge) or lies behind it all over the
+  // pixel; the one that took a sample of it is the likeliest not to, so it goes first.
+  auto misses = [&](int j) {
+    return (merged[j] == nullptr && interiors_disjoint(*tri[i], *tri[j])) ||
+           behind_all_over(*tri[j], *tri[i], x, y);
+  };
+  if (suspect >= 0 && !misses(suspect)) return false;
+  for (int j = 0; j < n; ++j) {
+    if (j != i && j != suspect && !misses(j)) return false;
   }
+  return true;
 }
 
 void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
@@ -861,27 +965,55 @@ void ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const Triangle
 
 glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,
                                        float& depth) {
-  // The mean of the samples' colours, as 256-sample MSAA would give: the samples of a
-  // tessellation's pieces add up to the whole pixel exactly, so no background leaks, which
-  // weighting each winner by its exact area times its share of won samples cannot promise
-  // (a piece too thin to own a sample would drop out).
+  // Each triangle that won samples shows over its exact area times the share of its own
+  // samples that it won (as sample_weights weighs fragments), and the background over its
+  // share of the samples. A piece too thin to own a sample drops out, so the triangles'
+  // weights are scaled to fill what the background leaves: the pieces of a tessellation
+  // still cover the pixel, and no background leaks where none shows.
   const PixelSamples& samples = samples_[tail_[pixel]];
-  double r = 0, g = 0, b = 0;
+  const TriangleSetup* winner[kMaskSamples];
+  int won[kMaskSamples];
+  int winners = 0, background_won = 0;
   const TriangleSetup* last = nullptr;
-  glm::vec3 c = background;
+  int last_slot = -1;
   depth = std::numeric_limits<float>::infinity();
   for (int s = 0; s < kMaskSamples; ++s) {
     const TriangleSetup* w = samples.winner[s];
-    if (w != last) {  // winners come in runs: shade each run once
-      last = w;
-      c = w != nullptr ? shade(*w, x + 0.5, y + 0.5, true) : background;
+    if (w == nullptr) {
+      ++background_won;
+      continue;
     }
-    if (w != nullptr) depth = std::min(depth, float(samples.z[s]));
-    r += c.r;
-    g += c.g;
-    b += c.b;
+    depth = std::min(depth, float(samples.z[s]));
+    if (w != last) {  // winners come in runs: look each run's up once
+      last = w;
+      last_slot = int(std::find(winner, winner + winners, w) - winner);
+      if (last_slot == winners) {
+        winner[winners] = w;
+        won[winners++] = 0;
+      }
+    }
+    ++won[last_slot];
   }
-  return glm::vec3(float(r / kMaskSamples), float(g / kMaskSamples), float(b / kMaskSamples));
+  double weight[kMaskSamples];
+  double total = 0.0;
+  for (int k = 0; k < winners; ++k) {
+    const int owned = pixel_sample_mask(*winner[k], x, y).count();
+    const double area = std::clamp(polygon_area(part_in_pixel(*winner[k], x, y)), 0.0, 1.0);
+    weight[k] = owned > 0 && area > 0.0 ? area * won[k] / owned : double(won[k]) / kMaskSamples;
+    total += weight[k];
+  }
+  const double background_share = double(background_won) / kMaskSamples;
+  const double scale = total > 0.0 ? (1.0 - background_share) / total : 0.0;
+  double r = background_share * background.r, g = background_share * background.g,
+         b = background_share * background.b;
+  for (int k = 0; k < winners; ++k) {
+    const glm::vec3 c = shade(*winner[k], x + 0.5, y + 0.5, true);
+    const double w = weight[k] * scale;
+    r += w * c.r;
+    g += w * c.g;
+    b += w * c.b;
+  }
+  return glm::vec3(float(r), float(g), float(b));
 }
 
 void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,

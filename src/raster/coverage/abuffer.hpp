@@ -220,15 +220,18 @@ class ABufferTile {
                            std::uint32_t coverage, double centre_z);
   /// The merged data of fragment `f` (which has kMergedFlag).
   const MergedPiece& merged_piece(std::uint32_t f) const { return merged_[merged_slot_[f]]; }
-  void sample_weights(int x, int y, const TriangleSetup* opaque, int n,
-                      const TriangleSetup* const* tri, const std::uint32_t* cov,
-                      const MergedPiece* const* merged, double* weight) const;
-  /// Marks in `exact` the fragments that keep their exact area: in front of the opaque
-  /// surface, and every other fragment either misses them (a separating edge) or lies
-  /// behind them all over the pixel.
-  static void unhidden_fragments(int x, int y, const TriangleSetup* opaque, int n,
-                                 const TriangleSetup* const* tri, const MergedPiece* const* merged,
-                                 bool* exact);
+  /// Each fragment's visible weight from the 16x16 samples (estimated[i]: a share of its
+  /// samples, not an exact area); returns how many samples the opaque surface or the
+  /// background behind keeps.
+  int sample_weights(int x, int y, const TriangleSetup* opaque, int n,
+                     const TriangleSetup* const* tri, const std::uint32_t* cov,
+                     const MergedPiece* const* merged, double* weight, bool* estimated) const;
+  /// Whether fragment i keeps its exact area: in front of the opaque surface, and every
+  /// other fragment either misses it (a separating edge) or lies behind it all over the
+  /// pixel. `suspect` (or -1): a fragment to test first, one that took a sample of it.
+  static bool shows_whole(int x, int y, const TriangleSetup* opaque, int n,
+                          const TriangleSetup* const* tri, const MergedPiece* const* merged, int i,
+                          int suspect);
   /// Writes the pixels `r` that show `opaque` (null: the background) alone into the frame.
   void resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
                             const FrameTarget& target);
