@@ -1,9 +1,9 @@
-// Tests of the 16x16 sub-pixel sample mask of the coverage resolve (src/resolve/sample_mask.hpp):
-// masks computed by hand (ties of the top-left rule on sample columns and rows, a tiny
-// triangle around one sample, two triangles sharing a diagonal through samples), the scalar
-// reference against a direct per-sample evaluation, and every Highway target compiled and
-// supported here against the scalar reference, bit for bit, on 200,000 random
-// (triangle, pixel) pairs.
+// Tests of the 256-sample sub-pixel mask of the coverage resolve
+// (src/raster/coverage/sample_mask.hpp): the lattice's layout (one sample per fine column and
+// row), masks computed by hand (axis-aligned edges, a tiny triangle around one sample, two
+// triangles sharing a diagonal through a sample), the scalar reference against a direct
+// per-sample evaluation, and every Highway target compiled and supported here against the
+// scalar reference, bit for bit, on 200,000 random (triangle, pixel) pairs.
 #include "core/edge_function.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/coverage/sample_mask.hpp"
@@ -27,8 +27,9 @@
 namespace {
 
 using covrast::detail::force_sample_mask_target;
-using covrast::detail::kMaskGridSide;
 using covrast::detail::kMaskSamples;
+using covrast::detail::kMaskSampleX_fx9;
+using covrast::detail::kMaskSampleY_fx9;
 using covrast::detail::kSubpixelOne;
 using covrast::detail::pixel_sample_mask;
 using covrast::detail::pixel_sample_mask_scalar;
@@ -50,29 +51,38 @@ TriangleSetup make_triangle(std::int32_t x0, std::int32_t y0, std::int32_t x1, s
   return t;
 }
 
-/// Position of sample k (0..15) of pixel p along one axis [fx8]: p + (k + 0.5) / 16 pixels.
-constexpr std::int32_t sample_fx8(int p, int k) { return p * kSubpixelOne + 8 + 16 * k; }
+/// Sample k of pixel (x, y) [fx9: 1/512 pixel].
+std::int64_t sample_x_fx9(int x, int k) {
+  return std::int64_t(x) * 512 + kMaskSampleX_fx9[std::size_t(k)];
+}
+std::int64_t sample_y_fx9(int y, int k) {
+  return std::int64_t(y) * 512 + kMaskSampleY_fx9[std::size_t(k)];
+}
 
-/// The mask of the samples (i, j) for which `inside(i, j)` holds: bit j * 16 + i.
+/// The mask of the samples k of pixel (x, y) whose position (fx9) satisfies `inside`.
 template <class Inside>
-SampleMask grid_mask(Inside inside) {
+SampleMask mask_where(int x, int y, Inside inside) {
   SampleMask mask = SampleMask::none();
-  for (int j = 0; j < kMaskGridSide; ++j) {
-    for (int i = 0; i < kMaskGridSide; ++i) {
-      const int s = j * kMaskGridSide + i;
-      if (inside(i, j)) mask.word[s / 64] |= std::uint64_t(1) << (s % 64);
+  for (int k = 0; k < kMaskSamples; ++k) {
+    if (inside(sample_x_fx9(x, k), sample_y_fx9(y, k))) {
+      mask.word[k / 64] |= std::uint64_t(1) << (k % 64);
     }
   }
   return mask;
 }
 
-/// The mask from the edge functions evaluated at every sample directly (no stepping).
+/// Edge function e at a point in fx9 units, from its definition (2 E, exact: the point is
+/// (px / 2, py / 2) in fx8) plus the top-left bias.
+std::int64_t edge_at_fx9(const covrast::detail::EdgeFunction& e, std::int64_t px, std::int64_t py) {
+  return e.dx * (py - 2 * e.y0) - e.dy * (px - 2 * e.x0) + e.bias;
+}
+
+/// The mask from the edge functions evaluated at every sample directly.
 SampleMask direct_mask(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
-  return grid_mask([&](int i, int j) {
-    const std::int64_t px = std::int64_t(sample_fx8(x, i)), py = std::int64_t(sample_fx8(y, j));
+  return mask_where(x, y, [&](std::int64_t px, std::int64_t py) {
     bool inside = true;
-    for (const auto& e : edges.e) inside = inside && e.at(px, py) >= 0;
+    for (const auto& e : edges.e) inside = inside && edge_at_fx9(e, px, py) >= 0;
     return inside;
   });
 }
@@ -82,8 +92,8 @@ int crossing_edges(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
   int crossing = 0;
   for (const auto& e : edges.e) {
-    const int inside = grid_mask([&](int i, int j) {
-                         return e.at(sample_fx8(x, i), sample_fx8(y, j)) >= 0;
+    const int inside = mask_where(x, y, [&](std::int64_t px, std::int64_t py) {
+                         return edge_at_fx9(e, px, py) >= 0;
                        }).count();
     crossing += inside > 0 && inside < kMaskSamples;
   }
@@ -122,113 +132,92 @@ void for_each_implementation(const std::function<void(const std::string&, MaskFn
   force_sample_mask_target(0);
 }
 
-TEST_CASE("sample mask: hand-computed masks and top-left ties", "[coverage]") {
-  // Sample k of a pixel lies at (2k + 1) / 32 along each axis: 1/32, 3/32, ..., 31/32.
-  const SampleMask left_columns = grid_mask([](int i, int) { return i < 8; });
-  const SampleMask right_columns = grid_mask([](int i, int) { return i >= 8; });
-  const SampleMask top_rows = grid_mask([](int, int j) { return j < 8; });
-  const SampleMask bottom_rows = grid_mask([](int, int j) { return j >= 8; });
-  // The grid's layout, spelled out: columns 0..7 are the low byte of every 16-bit row.
-  for (std::uint64_t w : left_columns.word) REQUIRE(w == 0x00FF00FF00FF00FFull);
-  for (int j = 0; j < kMaskGridSide; ++j) {
-    REQUIRE(left_columns.row(j) == 0x00FFu);
-    REQUIRE(bottom_rows.row(j) == (j >= 8 ? 0xFFFFu : 0u));
+TEST_CASE("sample mask: the lattice has one sample in every fine column and row", "[coverage]") {
+  std::vector<int> column(256, 0), row(256, 0);
+  for (int k = 0; k < kMaskSamples; ++k) {
+    const std::int32_t x = kMaskSampleX_fx9[std::size_t(k)], y = kMaskSampleY_fx9[std::size_t(k)];
+    REQUIRE(x == 2 * k + 1);
+    REQUIRE(y == 2 * (71 * k % 256) + 1);
+    ++column[std::size_t(x / 2)];
+    ++row[std::size_t(y / 2)];
   }
-  // Rows 0..7 are words 0 and 1.
-  REQUIRE(top_rows.word[0] == ~0ull);
-  REQUIRE(top_rows.word[1] == ~0ull);
-  REQUIRE(top_rows.word[2] == 0);
-  REQUIRE(top_rows.word[3] == 0);
-  constexpr std::int32_t kBig = 32 * kSubpixelOne;  // 32 px
+  CHECK(std::count(column.begin(), column.end(), 1) == 256);
+  CHECK(std::count(row.begin(), row.end(), 1) == 256);
+}
 
+TEST_CASE("sample mask: hand-computed masks and top-left ties", "[coverage]") {
+  constexpr std::int32_t kBig = 32 * kSubpixelOne;  // 32 px
+  // Fine column c holds sample c (x = (2c + 1) / 512), fine row r the sample k with
+  // 71 k = r (mod 256).
+  auto columns_below = [](int c) {
+    SampleMask m = SampleMask::none();
+    for (int k = 0; k < c; ++k) m.word[k / 64] |= std::uint64_t(1) << (k % 64);
+    return m;
+  };
   for_each_implementation([&](const std::string& name, MaskFn mask) {
     INFO(name);
     {
-      // Left half of pixel (10, 20), its right edge on the line x = 10.5 (vertical, A -> B
-      // goes down: a right edge, bias -1). x = 0.5 = 16/32 lies between sample columns 7
-      // (15/32) and 8 (17/32): no sample is on the line, the top-left rule has nothing to
-      // decide, and exactly columns 0..7 are inside in all 16 rows.
-      const std::int32_t line = 10 * kSubpixelOne + kSubpixelOne / 2;
+      // Left of the vertical line x = 10 + 77/256 in pixel (10, 20): the samples of fine
+      // columns 0..76, i.e. k < 77 (bits 0..63 and 64..76). Vertices lie on the 1/256 grid,
+      // samples halfway between: no sample is on the line. The triangle on the right, sharing
+      // the edge the other way, owns the other 179 samples.
+      const std::int32_t line = 10 * kSubpixelOne + 77;
       const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
-      const TriangleSetup left =
-          make_triangle(line, mid - kBig / 2, line, mid + kBig / 2, line - kBig, mid);
-      CHECK(hex(mask(left, 10, 20)) == hex(left_columns));
+      const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
+      const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
+      const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
+      const SampleMask expected = columns_below(77);
+      CHECK(expected.word[0] == ~0ull);
+      CHECK(expected.word[1] == (std::uint64_t(1) << 13) - 1);
+      CHECK(hex(mask(left, 10, 20)) == hex(expected));
+      CHECK(mask(right, 10, 20).count() == 256 - 77);
+      CHECK((mask(left, 10, 20) & mask(right, 10, 20)) == SampleMask::none());
       CHECK(mask(left, 9, 20) == SampleMask::all());    // the whole pixel to the left
       CHECK(mask(left, 11, 20) == SampleMask::none());  // the pixel to the right
     }
     {
-      // The line moved to x = 10 + 17/32, through sample column 8 (between two columns of
-      // an 8x8 grid). The triangle on the left has it as a right edge (A -> B downwards,
-      // dy > 0: bias -1): the samples on the line are not its own, it keeps columns 0..7.
-      // The triangle on the right shares the edge as B -> A (upwards, dy < 0: a left edge,
-      // bias 0) and owns column 8: columns 8..15. Each sample exactly once: disjoint, and
-      // together the whole pixel.
-      const std::int32_t line = sample_fx8(10, 8);
-      const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
-      const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
-      const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
-      const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
-      CHECK(hex(mask(left, 10, 20)) == hex(left_columns));
-      CHECK(hex(mask(right, 10, 20)) == hex(right_columns));
-    }
-    {
-      // The same with the line through the last column (x = 10 + 31/32): the left triangle
-      // keeps columns 0..14, the right one owns column 15 alone.
-      const std::int32_t line = sample_fx8(10, 15);
-      const std::int32_t mid = 20 * kSubpixelOne + kSubpixelOne / 2;
-      const std::int32_t ay = mid - kBig / 2, by = mid + kBig / 2;
-      const TriangleSetup left = make_triangle(line, ay, line, by, line - kBig, mid);
-      const TriangleSetup right = make_triangle(line, by, line, ay, line + kBig, mid);
-      CHECK(hex(mask(left, 10, 20)) == hex(grid_mask([](int i, int) { return i < 15; })));
-      CHECK(hex(mask(right, 10, 20)) == hex(grid_mask([](int i, int) { return i == 15; })));
-    }
-    {
-      // A horizontal edge through sample row 8 (y = 20 + 17/32). Below it, the edge runs
-      // A -> B to the right (dy == 0, dx > 0: a top edge, bias 0): the triangle below owns
-      // row 8, rows 8..15. Above, the same edge runs B -> A to the left (not a top edge):
-      // rows 0..7 only.
-      const std::int32_t line = sample_fx8(20, 8);
+      // Above the horizontal line y = 20 + 200/256: the samples of fine rows 0..199, 200 of
+      // them, and exactly those whose y (fx9) is below 400.
+      const std::int32_t line = 20 * kSubpixelOne + 200;
       const std::int32_t mid = 10 * kSubpixelOne + kSubpixelOne / 2;
-      const TriangleSetup below =
-          make_triangle(mid - kBig, line, mid + kBig, line, mid, line + kBig);
       const TriangleSetup above =
           make_triangle(mid + kBig, line, mid - kBig, line, mid, line - kBig);
-      CHECK(hex(mask(below, 10, 20)) == hex(bottom_rows));
-      CHECK(hex(mask(above, 10, 20)) == hex(top_rows));
+      const SampleMask got = mask(above, 10, 20);
+      CHECK(got.count() == 200);
+      CHECK(hex(got) == hex(mask_where(10, 20, [](std::int64_t, std::int64_t py) {
+              return py < 20 * 512 + 400;
+            })));
     }
     {
-      // A triangle 6 x 5 fx8 units around sample (i, j) = (13, 11) of pixel (-3, 7), far
-      // smaller than the 16-unit sample spacing: that one sample, bit 11 * 16 + 13 = 189
-      // (bit 61 of word 2).
-      const std::int32_t sx = sample_fx8(-3, 13), sy = sample_fx8(7, 11);
-      const TriangleSetup tiny = make_triangle(sx - 3, sy - 2, sx + 3, sy - 2, sx, sy + 3);
+      // A triangle 3 x 3 fx8 units around sample 37 of pixel (-3, 7): that sample alone.
+      const int k = 37;
+      const std::int32_t sx = -3 * kSubpixelOne + kMaskSampleX_fx9[k] / 2;  // just left of it
+      const std::int32_t sy = 7 * kSubpixelOne + kMaskSampleY_fx9[k] / 2;   // just above it
+      const TriangleSetup tiny = make_triangle(sx - 1, sy - 1, sx + 2, sy - 1, sx, sy + 2);
       SampleMask one = SampleMask::none();
-      one.word[2] = std::uint64_t(1) << 61;
+      one.word[0] = std::uint64_t(1) << k;
       CHECK(hex(mask(tiny, -3, 7)) == hex(one));
       CHECK(mask(tiny, -2, 7) == SampleMask::none());
-      // The same shape around the pixel centre (16/32, 16/32) lies between samples: no bit.
-      const std::int32_t cx = -3 * kSubpixelOne + 128, cy = 7 * kSubpixelOne + 128;
-      const TriangleSetup between = make_triangle(cx - 3, cy - 2, cx + 3, cy - 2, cx, cy + 3);
-      CHECK(mask(between, -3, 7) == SampleMask::none());
     }
     {
-      // The square [8/32, 24/32]^2 of pixel (5, -2) holds samples i, j = 4..11 (its sides
-      // lie between sample lines). Split along its diagonal from (8/32, 8/32) to
-      // (24/32, 24/32), which passes through the samples (k, k), k = 4..11. Upper-right
-      // triangle (y < x) P0 -> P1 -> P2: the diagonal is P2 -> P0, going up (dy < 0): a left
-      // edge, so it owns the diagonal: i >= j. Lower-left P0 -> P2 -> P3: the diagonal goes
-      // down (dy > 0), not top-left: i < j.
+      // The square [64/256, 192/256]^2 of pixel (5, -2), split along its diagonal from
+      // (64, 64) to (192, 192) [fx8], which passes through sample 128 at (128.5, 128.5)
+      // (71 * 128 = 128 mod 256). Upper-right triangle P0 -> P1 -> P2: the diagonal is
+      // P2 -> P0, going up (dy < 0): a left edge, so it owns the sample on it. Lower-left
+      // P0 -> P2 -> P3: the diagonal goes down (dy > 0), not top-left.
       const std::int32_t x0 = 5 * kSubpixelOne + 64, x1 = 5 * kSubpixelOne + 192;
       const std::int32_t y0 = -2 * kSubpixelOne + 64, y1 = -2 * kSubpixelOne + 192;
       const TriangleSetup upper_right = make_triangle(x0, y0, x1, y0, x1, y1);
       const TriangleSetup lower_left = make_triangle(x0, y0, x1, y1, x0, y1);
-      auto in_square = [](int i, int j) { return i >= 4 && i <= 11 && j >= 4 && j <= 11; };
       const SampleMask ur = mask(upper_right, 5, -2), ll = mask(lower_left, 5, -2);
-      CHECK(hex(ur) == hex(grid_mask([&](int i, int j) { return in_square(i, j) && i >= j; })));
-      CHECK(hex(ll) == hex(grid_mask([&](int i, int j) { return in_square(i, j) && i < j; })));
+      const SampleMask square = mask_where(5, -2, [&](std::int64_t px, std::int64_t py) {
+        return px > 2 * x0 && px < 2 * x1 && py > 2 * y0 && py < 2 * y1;
+      });
+      CHECK(ur.has(128));
+      CHECK(!ll.has(128));
       CHECK((ur & ll) == SampleMask::none());
-      CHECK(hex(ur | ll) == hex(grid_mask(in_square)));
-      CHECK((ur | ll).count() == 64);
+      CHECK(hex(ur | ll) == hex(square));
+      CHECK(square.count() == 63);  // the lattice's count in this quarter of the pixel
     }
   });
 }
@@ -245,14 +234,15 @@ class CaseGenerator {
     return std::uniform_int_distribution<std::int64_t>(lo, hi)(rng_);
   }
 
-  /// Moves a coordinate onto a lattice now and then: pixel border, sample, half pixel.
+  /// Moves a coordinate onto a lattice now and then: pixel border, a sample's column or
+  /// row, half pixel.
   std::int32_t snap(std::int64_t v) {
     const std::int64_t pixel = v >> 8;  // floor
     switch (uniform(0, 5)) {
       case 0:
         return std::int32_t(pixel * kSubpixelOne);
-      case 1:
-        return std::int32_t(pixel * kSubpixelOne + 8 + 16 * uniform(0, kMaskGridSide - 1));
+      case 1:  // next to a sample: its column (fx8 = k) or row
+        return std::int32_t(pixel * kSubpixelOne + uniform(0, kSubpixelOne - 1));
       case 2:
         return std::int32_t(pixel * kSubpixelOne + 128);
       default:

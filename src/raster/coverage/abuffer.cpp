@@ -713,24 +713,33 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
 namespace {
 
 /// Offsets of the sample rows and columns from sample (0, 0) [pixels]: k / 16, exact.
-constexpr auto kSampleOffset = [] {
-  std::array<double, kMaskGridSide> offset{};
-  for (int k = 0; k < kMaskGridSide; ++k) offset[std::size_t(k)] = double(k) / kMaskGridSide;
+/// Sample offsets from the pixel's corner [pixels], exact in double.
+constexpr auto kSampleOffsetX = [] {
+  std::array<double, kMaskSamples> offset{};
+  for (int k = 0; k < kMaskSamples; ++k) {
+    offset[std::size_t(k)] = double(kMaskSampleX_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
+  }
+  return offset;
+}();
+constexpr auto kSampleOffsetY = [] {
+  std::array<double, kMaskSamples> offset{};
+  for (int k = 0; k < kMaskSamples; ++k) {
+    offset[std::size_t(k)] = double(kMaskSampleY_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
+  }
   return offset;
 }();
 
-/// A triangle's plane at the samples of one pixel: z(i, j) = row(j) + dz/dx * i / 16,
-/// row(j) = z00 + dz/dy * j / 16, z00 its depth at sample (0, 0). Every comparison of
-/// sample_weights uses these expressions (no contraction: -ffp-contract=off), so its results
+/// A triangle's plane at the samples of one pixel: z(k) = z0 + dz/dx * x(k) + dz/dy * y(k),
+/// z0 its depth at the pixel's corner, (x(k), y(k)) sample k's offset. Every comparison of
+/// sample_weights uses this expression (no contraction: -ffp-contract=off), so its results
 /// do not depend on where or how often they are evaluated.
 struct SamplePlane {
-  double z00, dzdx, dzdy;
+  double z0, dzdx, dzdy;
   SamplePlane(const TriangleSetup& t, int x, int y)
-      : z00(t.depth_at(x + 0.5 / kMaskGridSide, y + 0.5 / kMaskGridSide)),
-        dzdx(t.dzdx),
-        dzdy(t.dzdy) {}
-  double row(int j) const { return z00 + dzdy * kSampleOffset[std::size_t(j)]; }
-  double at(double row_z, int i) const { return row_z + dzdx * kSampleOffset[std::size_t(i)]; }
+      : z0(t.depth_at(x, y)), dzdx(t.dzdx), dzdy(t.dzdy) {}
+  double at(int k) const {
+    return z0 + dzdx * kSampleOffsetX[std::size_t(k)] + dzdy * kSampleOffsetY[std::size_t(k)];
+  }
 };
 
 /// The fragment that took one of fragment i's samples (its mask `mine`; `best` holds each
@@ -801,10 +810,7 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
   static_assert(kMaxFragmentsPerPixel < 256);
   if (opaque != nullptr) {
     const SamplePlane plane(*opaque, x, y);
-    for (int j = 0; j < kMaskGridSide; ++j) {
-      const double row_z = plane.row(j);
-      for (int i = 0; i < kMaskGridSide; ++i) best_z[j * kMaskGridSide + i] = plane.at(row_z, i);
-    }
+    for (int s = 0; s < kMaskSamples; ++s) best_z[s] = plane.at(s);
   } else {
     std::fill(best_z, best_z + kMaskSamples, std::numeric_limits<double>::infinity());
   }
@@ -816,20 +822,14 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
   // on the order fragments are visited in.
   auto depth_test = [&](const SampleMask& owned, const TriangleSetup& t, int i) {
     const SamplePlane plane(t, x, y);
-    for (int j = 0; j < kMaskGridSide; ++j) {
-      std::uint32_t bits = owned.row(j);
-      if (bits == 0) continue;
-      const double row_z = plane.row(j);
-      for (; bits != 0; bits &= bits - 1) {
-        const int k = std::countr_zero(bits), s = j * kMaskGridSide + k;
-        const double z = plane.at(row_z, k);
-        if (z < best_z[s] || (z == best_z[s] && t.primitive < best_primitive[s])) {
-          best_z[s] = z;
-          best_primitive[s] = t.primitive;
-          best[s] = std::uint8_t(i + 1);
-        }
+    for_each_sample(owned, [&](int s) {
+      const double z = plane.at(s);
+      if (z < best_z[s] || (z == best_z[s] && t.primitive < best_primitive[s])) {
+        best_z[s] = z;
+        best_primitive[s] = t.primitive;
+        best[s] = std::uint8_t(i + 1);
       }
-    }
+    });
   };
   SampleMask mask[kMaxFragmentsPerPixel];
   for (int i = 0; i < n; ++i) {
@@ -862,12 +862,9 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
       estimated[i] = true;
     } else if (double px, py;
                merged[i] == nullptr && inner_point(part_in_pixel(*tri[i], x, y), px, py)) {
-      // Too thin to own a sample: visible or not where it is, at the sample nearest to a
-      // point inside its part of the pixel (its plane against that sample's winner).
-      const int si = std::clamp(int((px - x) * kMaskGridSide), 0, kMaskGridSide - 1);
-      const int sj = std::clamp(int((py - y) * kMaskGridSide), 0, kMaskGridSide - 1);
-      const SamplePlane plane(*tri[i], x, y);
-      share = plane.at(plane.row(sj), si) < best_z[sj * kMaskGridSide + si] &&
+      // Too thin to own a sample: visible or not where it is, at a point inside its part of
+      // the pixel, against the opaque surface and every fragment covering that point.
+      share = (opaque == nullptr || tri[i]->depth_at(px, py) < opaque->depth_at(px, py)) &&
                       nearest_at_point(n, tri, merged, i, px, py)
                   ? 1.0
                   : 0.0;
@@ -876,12 +873,7 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
       // where its plane would be nearer than what won them.
       const SamplePlane plane(*tri[i], x, y);
       int nearer = 0;
-      for (int j = 0; j < kMaskGridSide; ++j) {
-        const double row_z = plane.row(j);
-        for (int k = 0; k < kMaskGridSide; ++k) {
-          nearer += plane.at(row_z, k) < best_z[j * kMaskGridSide + k];
-        }
-      }
+      for (int k = 0; k < kMaskSamples; ++k) nearer += plane.at(k) < best_z[k];
       share = nearer / double(kMaskSamples);
       estimated[i] = true;
     }
@@ -916,10 +908,7 @@ void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
   const TriangleSetup* opaque = opaque_[pixel];
   if (opaque != nullptr) {
     const SamplePlane plane(*opaque, x, y);
-    for (int j = 0; j < kMaskGridSide; ++j) {
-      const double row_z = plane.row(j);
-      for (int i = 0; i < kMaskGridSide; ++i) samples.z[j * kMaskGridSide + i] = plane.at(row_z, i);
-    }
+    for (int s = 0; s < kMaskSamples; ++s) samples.z[s] = plane.at(s);
   } else {
     std::fill(samples.z, samples.z + kMaskSamples, kFar);
   }
@@ -946,21 +935,15 @@ void ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const Triangle
   PixelSamples& samples = samples_[tail_[pixel]];
   const SampleMask mask = pixel_sample_mask(t, x, y);
   const SamplePlane plane(t, x, y);
-  for (int j = 0; j < kMaskGridSide; ++j) {
-    std::uint32_t bits = mask.row(j);
-    if (bits == 0) continue;
-    const double row_z = plane.row(j);
-    for (; bits != 0; bits &= bits - 1) {
-      const int s = j * kMaskGridSide + std::countr_zero(bits);
-      const double z = plane.at(row_z, std::countr_zero(bits));
-      const TriangleSetup* w = samples.winner[s];
-      // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
-      if (z < samples.z[s] || (z == samples.z[s] && w != nullptr && t.primitive < w->primitive)) {
-        samples.z[s] = z;
-        samples.winner[s] = &t;
-      }
+  for_each_sample(mask, [&](int s) {
+    const double z = plane.at(s);
+    const TriangleSetup* w = samples.winner[s];
+    // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
+    if (z < samples.z[s] || (z == samples.z[s] && w != nullptr && t.primitive < w->primitive)) {
+      samples.z[s] = z;
+      samples.winner[s] = &t;
     }
-  }
+  });
 }
 
 glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,

@@ -1,25 +1,21 @@
-// Resolve stage, coverage mode: the 16x16 sub-pixel sample mask (sample_mask.hpp), scalar
-// reference and SIMD version, one source compiled for every Highway target.
+// Coverage mode: the 256-sample sub-pixel mask (sample_mask.hpp), scalar reference and SIMD
+// version, one source compiled for every Highway target.
 //
-// Why the SIMD version is exact. With samples 16 fx8 units apart, edge e at sample (i, j)
-// is, exactly in int64,
+// Why the SIMD version is exact. In units of 1/512 pixel (fx9) edge e at sample k of pixel
+// (x, y) is, exactly in int64, twice the fx8 edge function:
 //
-//   E(i, j) = E00 + 16 * o(i, j),   o(i, j) = j * dx - i * dy,
+//   E2(k) = C + dx * Y(k) - dy * X(k),   C = dx (512 y - 2 y0) - dy (512 x - 2 x0) + bias,
 //
-// E00 = E + bias at sample (0, 0), (dx, dy) the edge vector [fx8]. As o is an integer,
-//
-//   E(i, j) >= 0  <=>  o >= -E00 / 16  <=>  o + F >= 0,   F = floor(E00 / 16) = E00 >> 4.
-//
-// o is extreme at the grid's corners: o_min = 15 min(dx, 0) - 15 max(dy, 0), o_max likewise.
-// F + o_min >= 0: the edge holds every sample (it is skipped); F + o_max < 0: it holds
-// none (mask 0). Otherwise the edge crosses the grid and is tested per sample on int32
-// lanes: with |dx|, |dy| <= 2^25 (vertices within +-2^24 fx8, i.e. +-65536 px; the guard
-// band keeps them within +-32768 px) |o| <= 15 * 2^26 < 2^30, and F clamped to
-// [-2^30, 2^30] leaves the sign of o + F unchanged while |o + F| < 2^31. The lanes step
-// from sample to sample, so every value they hold is such an o + F (never one past the
-// grid), and the steps themselves (dx a row, -N dy a vector of N <= 16 lanes: at most 2^29)
-// and lane * dy (at most 15 * 2^25) fit as well. Larger edges take the scalar reference.
-// tests/test_sample_mask.cpp checks the bits on every target.
+// with (X(k), Y(k)) the sample's offset [fx9] (odd, in [1, 511]), (dx, dy) the edge vector
+// and (x0, y0) its first vertex [fx8]; inside <=> E2 >= 0 (the bias of the top-left rule is
+// the same as for integer positions, as E2 is an integer and E2 = 0 exactly on the edge).
+// T(k) = dx Y - dy X lies in [T_lo, T_hi], its extremes over the box [1, 511]^2.
+// C + T_lo >= 0: the edge holds every sample (it is skipped); C + T_hi < 0: it holds none
+// (mask 0). Otherwise the edge crosses the pixel and is tested per sample on int32 lanes:
+// with |dx|, |dy| <= 2^20 (edges up to 4096 px) |T| <= 511 * 2^21 < 2^30, a crossing edge
+// has -T_hi <= C < -T_lo, so |C| < 2^30 and every C + T fits in int32, as do the products.
+// Longer edges take the scalar reference. tests/test_sample_mask.cpp checks the bits on every
+// target.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "raster/coverage/sample_mask.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
@@ -32,18 +28,16 @@
 #include <cstdlib>
 #include <cstring>
 
-#ifndef COVRAST_RESOLVE_SAMPLE_MASK_ONCE_
-#define COVRAST_RESOLVE_SAMPLE_MASK_ONCE_
+#ifndef COVRAST_COVERAGE_SAMPLE_MASK_ONCE_
+#define COVRAST_COVERAGE_SAMPLE_MASK_ONCE_
 namespace covrast::detail {
 
 /// Largest |dx|, |dy| [fx8] of an edge the int32 lanes take (see the top of the file).
-inline constexpr std::int64_t kMaxLaneEdgeFx8 = std::int64_t(1) << 25;
-/// F is clamped to +-kLaneClamp: beyond it o + F has the sign of F for every sample.
-inline constexpr std::int64_t kLaneClamp = std::int64_t(1) << 30;
+inline constexpr std::int64_t kMaxLaneEdgeFx8 = std::int64_t(1) << 20;
 
-/// The edges that cross the sample grid: o + f[e] >= 0 inside, o = j * dx[e] - i * dy[e].
+/// The edges that cross the pixel's samples: C[e] + dx[e] Y(k) - dy[e] X(k) >= 0 inside.
 struct CrossingEdges {
-  std::int32_t f[3];
+  std::int32_t c[3];
   std::int32_t dx[3];
   std::int32_t dy[3];
   int count;  ///< 1 to 3
@@ -69,38 +63,30 @@ HWY_INLINE std::uint64_t LaneBits(DI d, hn::Mask<DI> inside) {
   return bits;
 }
 
-/// Mask of the samples inside all kEdges crossing edges. Row j is walked in vectors of
-/// N = Lanes(d) samples: lane l of the vector at column c0 is sample (c0 + l, j), bit
-/// s = 16 j + c0 + l; as N divides 64, a vector's bits never straddle two words.
+/// Mask of the samples inside all kEdges crossing edges, N = Lanes(d) samples a vector:
+/// lane l of the vector at k0 is sample k0 + l, bit k0 + l; as N divides 64, a vector's
+/// bits never straddle two words.
 template <int kEdges>
 HWY_INLINE SampleMask CrossingMask(const CrossingEdges& c) {
   const DI d;
   const int n = int(hn::Lanes(d));
   const auto minus_one = hn::Set(d, -1);
-  const auto lane = hn::Iota(d, 0);
-  // row[e]: o + F at samples (l, j) of the current row; o grows by dx a row and by -dy a
-  // column, so by -N dy a vector.
-  hn::Vec<DI> row[kEdges], column_step[kEdges];
+  hn::Vec<DI> base[kEdges], dx[kEdges], dy[kEdges];
   for (int e = 0; e < kEdges; ++e) {
-    row[e] = hn::Sub(hn::Set(d, c.f[e]), hn::Mul(lane, hn::Set(d, c.dy[e])));
-    column_step[e] = hn::Set(d, -c.dy[e] * n);
+    base[e] = hn::Set(d, c.c[e]);
+    dx[e] = hn::Set(d, c.dx[e]);
+    dy[e] = hn::Set(d, c.dy[e]);
   }
   SampleMask mask = SampleMask::none();
-  for (int j = 0;;) {
-    hn::Vec<DI> v[kEdges];
-    for (int e = 0; e < kEdges; ++e) v[e] = row[e];
-    for (int c0 = 0;;) {
-      auto any = v[0];
-      for (int e = 1; e < kEdges; ++e) any = hn::Or(any, v[e]);
-      // Inside every edge <=> no sign bit in any of the values.
-      const int s = j * kMaskGridSide + c0;
-      mask.word[s >> 6] |= LaneBits(d, hn::Gt(any, minus_one)) << (s & 63);
-      c0 += n;
-      if (c0 >= kMaskGridSide) break;
-      for (int e = 0; e < kEdges; ++e) v[e] = hn::Add(v[e], column_step[e]);
+  for (int k0 = 0; k0 < kMaskSamples; k0 += n) {
+    const auto sx = hn::LoadU(d, kMaskSampleX_fx9.data() + k0);
+    const auto sy = hn::LoadU(d, kMaskSampleY_fx9.data() + k0);
+    auto any = hn::Sub(hn::Add(base[0], hn::Mul(dx[0], sy)), hn::Mul(dy[0], sx));
+    for (int e = 1; e < kEdges; ++e) {
+      any = hn::Or(any, hn::Sub(hn::Add(base[e], hn::Mul(dx[e], sy)), hn::Mul(dy[e], sx)));
     }
-    if (++j == kMaskGridSide) break;
-    for (int e = 0; e < kEdges; ++e) row[e] = hn::Add(row[e], hn::Set(d, c.dx[e]));
+    // Inside every edge <=> no sign bit in any of the values.
+    mask.word[k0 >> 6] |= LaneBits(d, hn::Gt(any, minus_one)) << (k0 & 63);
   }
   return mask;
 }
@@ -126,55 +112,49 @@ HWY_EXPORT(SampleMaskCrossing);
 
 namespace {
 
-constexpr std::int64_t kSampleStepFx8 = kSubpixelOne / kMaskGridSide;  // 16 fx8 units
-constexpr std::int64_t kLastSample = kMaskGridSide - 1;
+/// 2 E + bias at the corner (x, y) of the pixel in fx9 units, less the sample offset's
+/// part: C of the top of the file.
+std::int64_t corner_term(const EdgeFunction& e, int x, int y) {
+  return e.dx * (std::int64_t(y) * kMaskUnitsPerPixel - 2 * e.y0) -
+         e.dy * (std::int64_t(x) * kMaskUnitsPerPixel - 2 * e.x0) + e.bias;
+}
 
 }  // namespace
 
 SampleMask pixel_sample_mask_scalar(const TriangleSetup& t, int x, int y) {
-  TriangleEdges edges(t);
-  const std::int64_t sx = std::int64_t(x) * kSubpixelOne + kSampleStepFx8 / 2;
-  const std::int64_t sy = std::int64_t(y) * kSubpixelOne + kSampleStepFx8 / 2;
+  const TriangleEdges edges(t);
+  const std::int64_t px0 = std::int64_t(x) * kMaskUnitsPerPixel;
+  const std::int64_t py0 = std::int64_t(y) * kMaskUnitsPerPixel;
   SampleMask mask = SampleMask::none();
-  std::int64_t row[3], dx[3], dy[3];
-  for (int e = 0; e < 3; ++e) {
-    row[e] = edges.e[e].at(sx, sy);
-    dx[e] = edges.e[e].step_x(kSampleStepFx8);
-    dy[e] = edges.e[e].step_y(kSampleStepFx8);
-  }
-  for (int j = 0; j < kMaskGridSide; ++j) {
-    std::int64_t e0 = row[0], e1 = row[1], e2 = row[2];
-    for (int i = 0; i < kMaskGridSide; ++i) {
-      const int s = j * kMaskGridSide + i;
-      if ((e0 | e1 | e2) >= 0) mask.word[s >> 6] |= std::uint64_t(1) << (s & 63);
-      e0 += dx[0];
-      e1 += dx[1];
-      e2 += dx[2];
+  for (int k = 0; k < kMaskSamples; ++k) {
+    const std::int64_t px = px0 + kMaskSampleX_fx9[std::size_t(k)];
+    const std::int64_t py = py0 + kMaskSampleY_fx9[std::size_t(k)];
+    bool inside = true;
+    for (const EdgeFunction& e : edges.e) {
+      inside = inside && e.dx * (py - 2 * e.y0) - e.dy * (px - 2 * e.x0) + e.bias >= 0;
     }
-    for (int e = 0; e < 3; ++e) row[e] += dy[e];
+    if (inside) mask.word[k >> 6] |= std::uint64_t(1) << (k & 63);
   }
   return mask;
 }
 
 SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
-  const std::int64_t sx = std::int64_t(x) * kSubpixelOne + kSampleStepFx8 / 2;
-  const std::int64_t sy = std::int64_t(y) * kSubpixelOne + kSampleStepFx8 / 2;
+  constexpr std::int64_t kLo = 1, kHi = kMaskUnitsPerPixel - 1;  // sample offsets [fx9]
   CrossingEdges crossing;
   crossing.count = 0;
   bool narrow = true;  // every crossing edge fits the int32 lanes
   for (const EdgeFunction& edge : edges.e) {
-    // F = floor(E00 / 16): the arithmetic shift rounds towards -infinity.
-    const std::int64_t f = edge.at(sx, sy) >> 4;
-    const std::int64_t o_min =
-        kLastSample * (std::min<std::int64_t>(edge.dx, 0) - std::max<std::int64_t>(edge.dy, 0));
-    const std::int64_t o_max =
-        kLastSample * (std::max<std::int64_t>(edge.dx, 0) - std::min<std::int64_t>(edge.dy, 0));
-    if (f + o_max < 0) return SampleMask::none();  // all four extreme samples outside this edge
-    if (f + o_min >= 0) continue;                  // all four inside: so is every sample
+    const std::int64_t c = corner_term(edge, x, y);
+    const std::int64_t t_lo =
+        std::min(edge.dx * kLo, edge.dx * kHi) - std::max(edge.dy * kLo, edge.dy * kHi);
+    const std::int64_t t_hi =
+        std::max(edge.dx * kLo, edge.dx * kHi) - std::min(edge.dy * kLo, edge.dy * kHi);
+    if (c + t_hi < 0) return SampleMask::none();  // the whole sample box outside this edge
+    if (c + t_lo >= 0) continue;                  // all inside: so is every sample
     narrow = narrow && std::max(std::abs(edge.dx), std::abs(edge.dy)) <= kMaxLaneEdgeFx8;
     const int k = crossing.count++;
-    crossing.f[k] = std::int32_t(std::clamp(f, -kLaneClamp, kLaneClamp));
+    crossing.c[k] = std::int32_t(narrow ? c : 0);
     crossing.dx[k] = std::int32_t(edge.dx);
     crossing.dy[k] = std::int32_t(edge.dy);
   }
