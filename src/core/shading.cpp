@@ -14,6 +14,8 @@ namespace covrast::detail {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
+/// Smallest BRDF roughness alpha (= perceptual roughness^2), see pbr_brdf.
+constexpr double kMinAlpha = 1e-3;
 
 /// What one punctual light delivers at a point: the unit direction towards it and the
 /// irradiance on a surface facing it, E = radiance x attenuation (KHR_lights_punctual).
@@ -31,7 +33,7 @@ Incident incident(const PunctualLight& light, const glm::dvec3& p) {
   const double distance2 = glm::dot(d, d);
   if (!(distance2 > 0.0)) return {};
   const double distance = std::sqrt(distance2);
-  const glm::dvec3 l = d / distance;
+  const glm::dvec3 l = d * (1.0 / distance);
   double attenuation = 1.0 / distance2;
   if (light.inv_range > 0.0) {
     const double q = distance * light.inv_range;
@@ -103,36 +105,34 @@ glm::dvec3 pbr_radiance(const SurfaceShading& s, const glm::dvec3& base, const g
 
 // glTF 2.0 specification, Appendix B.3 (https://registry.khronos.org/glTF/specs/2.0/
 // glTF-2.0.html#appendix-b-brdf-implementation), the implementation form of B.3.5:
-//   alpha = roughness^2, c_diff = lerp(base, 0, metallic), f0 = lerp(0.04, base, metallic)
-//   F = f0 + (1 - f0) (1 - |v . h|)^5
-//   D = alpha^2 X+(n . h) / (pi ((n . h)^2 (alpha^2 - 1) + 1)^2)
-//   V = X+(h . l) / (|n . l| + sqrt(alpha^2 + (1 - alpha^2) (n . l)^2))
+//   alpha = max(roughness^2, 1e-3), c_diff = lerp(base, 0, metallic), f0 = lerp(0.04, base,
+//   metallic) F = f0 + (1 - f0) (1 - |v . h|)^5 D = alpha^2 X+(n . h) / (pi ((n . h)^2 (alpha^2 -
+//   1) + 1)^2) V = X+(h . l) / (|n . l| + sqrt(alpha^2 + (1 - alpha^2) (n . l)^2))
 //     x X+(h . v) / (|n . v| + sqrt(alpha^2 + (1 - alpha^2) (n . v)^2))
 //   f = (1 - F) c_diff / pi + F D V
 glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
                     const glm::dvec3& v, const glm::dvec3& l) {
   const glm::dvec3 c_diff = base * (1.0 - metallic);
   const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - metallic) + base * metallic;
-  const double alpha = roughness * roughness;
+  // alpha = 0 (a perfect mirror) makes D = 0/0 where n = h: kept at kMinAlpha, a highlight
+  // one pixel wide that the resolve clamps.
+  const double alpha = std::max(roughness * roughness, kMinAlpha);
   const double alpha2 = alpha * alpha;
   const glm::dvec3 h_sum = l + v;
   const double h_length = glm::length(h_sum);
-  const glm::dvec3 h = h_length > 0.0 ? h_sum / h_length : n;
+  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
   const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
   const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l), h_dot_v = glm::dot(h, v);
   const glm::dvec3 fresnel = f0 + (glm::dvec3(1.0) - f0) * schlick_weight(std::abs(h_dot_v));
-  double d = 0.0;
-  if (n_dot_h > 0.0) {
+  // D x V in one division: alpha^2 / (pi k^2 g_l g_v), k = (n.h)^2 (alpha^2 - 1) + 1.
+  double d_vis = 0.0;
+  if (n_dot_h > 0.0 && h_dot_l > 0.0 && h_dot_v > 0.0) {
     const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
-    d = alpha2 / (kPi * k * k);
-  }
-  double vis = 0.0;
-  if (h_dot_l > 0.0 && h_dot_v > 0.0) {
     const double gl = n_dot_l + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_l * n_dot_l);
     const double gv = n_dot_v + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_v * n_dot_v);
-    vis = 1.0 / (gl * gv);
+    d_vis = alpha2 / (kPi * k * k * (gl * gv));
   }
-  return (glm::dvec3(1.0) - fresnel) * c_diff * (1.0 / kPi) + fresnel * (d * vis);
+  return (glm::dvec3(1.0) - fresnel) * c_diff * (1.0 / kPi) + fresnel * d_vis;
 }
 
 glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
@@ -140,7 +140,7 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
   const ShadingContext& c = *s.context;
   const glm::dvec3 to_eye = c.eye_world - p;
   const double eye_distance = glm::length(to_eye);
-  const glm::dvec3 v = eye_distance > 0.0 ? to_eye / eye_distance : n;
+  const glm::dvec3 v = eye_distance > 0.0 ? to_eye * (1.0 / eye_distance) : n;
   switch (s.model) {
     case LitModel::Unlit:
       return base;
@@ -166,7 +166,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   glm::dvec3 n = mu0 * glm::dvec3(r.normal_world[0]) + mu1 * glm::dvec3(r.normal_world[1]) +
                  mu2 * glm::dvec3(r.normal_world[2]);
   const double n_length = glm::length(n);
-  n = n_length > 0.0 ? n / n_length : glm::dvec3(0.0);
+  n = n_length > 0.0 ? n * (1.0 / n_length) : glm::dvec3(0.0);
   return glm::vec3(shade_point(*r.surface, base, p, n));
 }
 

@@ -514,7 +514,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
     const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2, bool flat,
     std::uint32_t primitive, std::uint32_t surface, Sink& sink, const ShadeVertex* shade,
-    const SurfaceShading* lit) const {
+    const SurfaceShading* lit, const LazyShade* lazy) const {
   const std::int64_t ax = v1.x_fx8 - v0.x_fx8, ay = v1.y_fx8 - v0.y_fx8;
   const std::int64_t bx = v2.x_fx8 - v0.x_fx8, by = v2.y_fx8 - v0.y_fx8;
   const std::int64_t area2 = ax * by - bx * ay;
@@ -588,7 +588,14 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.flat_color = flat;
   t.convex_surface = sink.convex_surface;
   t.shading = nullptr;
-  if (shade != nullptr) {
+  if (lit != nullptr) {
+    // Computed only now, for triangles that survived every cull (half of a closed mesh's
+    // are hidden back faces).
+    ShadeVertex computed[3];
+    if (lazy != nullptr) {
+      shade_vertices(lazy->instance, lazy->local, *lazy->normal_matrix, lazy->det_sign, computed);
+      shade = computed;
+    }
     ShadingRecord& record = sink.shading->emplace_back();
     // A back face (the file's counter-clockwise front turned away: clockwise on screen, or
     // counter-clockwise under a mirroring model matrix) of a double-sided material is lit
@@ -742,14 +749,15 @@ void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std:
       ++sink.counters.culled;
       continue;
     }
-    ShadeVertex shade[3];
     const bool unlit = lit->model == LitModel::Unlit;
-    if (!unlit) shade_vertices(instance, local, normal_matrix, det_sign, shade);
     if ((o0 | o1 | o2) == 0) {
+      const LazyShade lazy{instance, local, &normal_matrix, det_sign};
       emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]],
                     color[0], color[1], color[2], flat, primitive, std::uint32_t(instance), sink,
-                    unlit ? nullptr : shade, unlit ? nullptr : lit);
+                    nullptr, unlit ? nullptr : lit, &lazy);
     } else {
+      ShadeVertex shade[3];
+      if (!unlit) shade_vertices(instance, local, normal_matrix, det_sign, shade);
       clip_triangle(instance, mvp, indices, color, flat, o0 | o1 | o2, primitive, sink,
                     unlit ? nullptr : shade, unlit ? nullptr : lit);
     }

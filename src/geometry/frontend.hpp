@@ -202,12 +202,20 @@ class GeometryFrontEnd {
     /// A new triangle at the end of the output, its fields to be written.
     TriangleSetup& next() { return chunk != nullptr ? chunk->emplace_back() : out->emplace_back(); }
   };
-  /// `shade`: for lit triangles the three ShadeVertex of v0, v1, v2 and their material
-  /// `lit`; both null for unlit ones.
+  /// Where emit_triangle computes a lit triangle's ShadeVertex (shade_vertices' arguments).
+  struct LazyShade {
+    std::size_t instance;
+    std::size_t local;
+    const glm::dmat3* normal_matrix;
+    double det_sign;
+  };
+  /// `lit`: a lit triangle's material, null for unlit ones; its ShadeVertex of v0, v1, v2 are
+  /// `shade`, or computed from `lazy` once the triangle has passed the culls.
   void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
                      const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2,
                      bool flat, std::uint32_t primitive, std::uint32_t surface, Sink& sink,
-                     const ShadeVertex* shade = nullptr, const SurfaceShading* lit = nullptr) const;
+                     const ShadeVertex* shade = nullptr, const SurfaceShading* lit = nullptr,
+                     const LazyShade* lazy = nullptr) const;
   /// `mvp`: view_projection_ times the instance's model matrix, as in transform_vertices.
   void clip_triangle(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
                      const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,

@@ -325,6 +325,10 @@ Material convert_material(const tinygltf::Material& source) {
     }
   }
   m.double_sided = source.doubleSided;
+  // emissiveFactor scales the emissive texture (3.9.4); without textures a factor of 1 would
+  // turn the whole surface into a lamp (DamagedHelmet), so the emission is left out and
+  // counted (LoadedMesh::lit_warnings).
+  if (source.emissiveTexture.index >= 0) m.emissive_linear = glm::vec3(0.0f);
   return m;
 }
 
@@ -404,8 +408,10 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   auto mesh = std::make_shared<MeshData>();
   mesh->source = display_name;
   // The file's materials, then glTF's default material for primitives without one.
+  std::size_t emissive_textures = 0;
   for (const tinygltf::Material& material : model.materials) {
     mesh->materials.push_back(convert_material(material));
+    if (material.emissiveTexture.index >= 0) ++emissive_textures;
   }
   mesh->materials.push_back(convert_material(tinygltf::Material{}));
   const auto default_material = static_cast<std::uint32_t>(model.materials.size());
@@ -572,6 +578,11 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   }
 
   LoadedMesh loaded;
+  if (emissive_textures > 0) {
+    loaded.lit_warnings.push_back(name + ": " + std::to_string(emissive_textures) +
+                                  " materials with an emissive texture: textures are not "
+                                  "rendered yet, their emission is left out");
+  }
   if (any_color_attribute || factors_differ) {
     // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
     mesh->colors_linear = std::move(colors);

@@ -25,6 +25,8 @@ struct LoadedMesh {
   std::size_t dropped_nonfinite_triangles = 0;
   /// What the file holds that covrast does not render, one line each (Scene::warnings).
   std::vector<std::string> warnings;
+  /// The same, for what matters only when the scene is lit (materials).
+  std::vector<std::string> lit_warnings;
 };
 
 /// Reads a whole file. On failure returns false and sets `error` to the system's reason

@@ -486,6 +486,9 @@ Scene load_scene(const std::filesystem::path& json_path) {
     const detail::LoadedMesh& loaded = cached->second.loaded;
     if (first_use) {
       for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
+      if (scene.lit) {
+        for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
+      }
     }
     // Counted per instance: each instance would have drawn the dropped triangles.
     scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
