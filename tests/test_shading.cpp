@@ -383,8 +383,9 @@ TEST_CASE("lit coverage is close to the lit reference", "[shading]") {
     worst = std::max(worst, d);
     sum2 += double(d) * d;
   }
-  CHECK(std::sqrt(sum2 / double(ref.rgb.size())) < 2.0);
-  CHECK(worst < 48);
+  // Measured: RMSE 0.37, largest 3 (8-bit units).
+  CHECK(std::sqrt(sum2 / double(ref.rgb.size())) < 0.75);
+  CHECK(worst <= 6);
 }
 
 TEST_CASE("a scene without lights renders exactly as unlit", "[shading]") {
