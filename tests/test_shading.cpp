@@ -310,6 +310,66 @@ TEST_CASE("pbr BRDF: white furnace albedo, exact at roughness 1", "[shading]") {
   }
 }
 
+TEST_CASE("point and spot lights: inverse square, range window and cone on a plane", "[shading]") {
+  Scene scene = camera_scene(100, 100);
+  auto plane = std::make_shared<covrast::MeshData>();
+  plane->positions = {{-3, -3, 0}, {3, -3, 0}, {3, 3, 0}, {-3, 3, 0}};
+  plane->indices = {0, 1, 2, 0, 2, 3};
+  const glm::vec3 base(0.9f, 0.7f, 0.5f);
+  covrast::test::add_instance(scene, plane, base);
+  scene.meshes[0].materials = {lambert()};
+  scene.lit = true;
+  Light point;
+  point.type = LightType::Point;
+  point.position = {-0.3, 0.2, 0.8};
+  point.intensity = 0.6;
+  point.range = 1.6;
+  Light spot;
+  spot.type = LightType::Spot;
+  spot.position = {0.4, -0.3, 1.0};
+  spot.direction = glm::normalize(glm::dvec3(0.1, 0.2, -1.0));
+  spot.inner_cone_deg = 12.0;
+  spot.outer_cone_deg = 25.0;
+  spot.intensity = 0.5;
+  scene.lights = {point, spot};
+  // KHR_lights_punctual: E = I / d^2 x clamp(1 - (d / range)^4, 0, 1) x cone^2.
+  const auto expected = [&](const glm::dvec3& p) {
+    double e = 0.0;
+    for (const Light& light : scene.lights) {
+      const glm::dvec3 to = light.position - p;
+      const double d = glm::length(to);
+      const glm::dvec3 l = to / d;
+      double a = light.intensity / (d * d) * std::max(0.0, l.z);  // n = +z
+      if (light.range > 0.0) a *= std::clamp(1.0 - std::pow(d / light.range, 4), 0.0, 1.0);
+      if (light.type == LightType::Spot) {
+        const double c_outer = std::cos(light.outer_cone_deg * kPi / 180.0);
+        const double c_inner = std::cos(light.inner_cone_deg * kPi / 180.0);
+        const double cone =
+            std::clamp((glm::dot(light.direction, -l) - c_outer) / (c_inner - c_outer), 0.0, 1.0);
+        a *= cone * cone;
+      }
+      e += a;
+    }
+    return e;
+  };
+  const covrast::Image image = render(scene, "aliased").color;
+  int worst = 0, lit_pixels = 0, dark_pixels = 0;
+  for (int y = 0; y < scene.height; ++y) {
+    for (int x = 0; x < scene.width; ++x) {
+      const glm::dvec3 d = pixel_ray(scene, x, y);
+      const glm::dvec3 p = scene.camera.eye + (-scene.camera.eye.z / d.z) * d;  // z = 0
+      const double e = expected(p);
+      const std::uint8_t* px = pixel(image, x, y);
+      for (int ch = 0; ch < 3; ++ch)
+        worst = std::max(worst, std::abs(int(px[ch]) - code(base[ch] * e)));
+      (e > 0.05 ? lit_pixels : dark_pixels) += 1;
+    }
+  }
+  CHECK(worst <= 1);
+  CHECK(lit_pixels > 1000);
+  CHECK(dark_pixels > 1000);  // beyond the range and outside the cone
+}
+
 namespace {
 
 /// Sphere, cube and a double-sided open quad under every light type, each model once.
