@@ -28,7 +28,7 @@ check() {  # scene mode size
     differ=$((differ + 1))
   fi
 }
-for scene in default slivers boxes near_plane overlap; do
+for scene in default slivers boxes near_plane overlap lit; do
   for mode in aliased coverage coverage-blend msaa:4 msaa:16 ssaa:4 ssaa-grid:3 ssaa-cmj:4; do
     check "$scene" "$mode" 320x180
   done
@@ -36,5 +36,6 @@ done
 check sphere_grid aliased 1920x1080
 check sphere_grid coverage 1920x1080
 check default reference 96x54
+check lit reference 96x54
 echo "g++ vs clang: $pairs image pairs, $differ differ"
 [ "$differ" -eq 0 ]

@@ -30,6 +30,51 @@ struct Camera {
   double far = 100.0;      ///< far plane distance [world units], > near
 };
 
+/// How a lit surface reflects light (docs/shading.md has every formula and its source).
+enum class ShadingModel : std::uint8_t {
+  Unlit,       ///< the base colour as is, today's flat, unlit look (KHR_materials_unlit)
+  Lambert,     ///< base * (ambient + sum E_i max(0, n . l_i)), no 1/pi
+  BlinnPhong,  ///< Lambert plus specular * max(0, n . h)^shininess per light
+  Pbr,         ///< glTF 2.0 metallic-roughness BRDF (specification, Appendix B)
+};
+
+/// A surface's material. The base colour is not here: it is the mesh's colour selection
+/// (uniform, per-triangle, vertex colours, glTF baseColorFactor x COLOR_0), as unlit.
+struct Material {
+  ShadingModel model = ShadingModel::Pbr;
+  float metallic = 1.0f;            ///< pbr, 0..1 (glTF default 1)
+  float roughness = 1.0f;           ///< pbr perceptual roughness, 0..1 (glTF default 1)
+  glm::vec3 emissive_linear{0.0f};  ///< added radiance, linear (x emissive strength)
+  float shininess = 32.0f;          ///< blinn-phong exponent, > 0
+  glm::vec3 specular_linear{0.5f};  ///< blinn-phong specular colour, linear
+  /// Back faces are lit with the flipped normal (glTF doubleSided). A single-sided
+  /// material lights them with the normal as it is (glTF would cull them; covrast draws
+  /// them, see docs/shading.md).
+  bool double_sided = true;
+};
+
+enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
+
+/// A light in world space (KHR_lights_punctual units: directional lux, point and spot
+/// candela; ambient is a uniform radiance). Colours are linear RGB.
+struct Light {
+  LightType type = LightType::Directional;
+  glm::dvec3 direction{0.0, 0.0, -1.0};  ///< where the light travels (directional, spot)
+  glm::dvec3 position{0.0};              ///< point, spot [world units]
+  glm::vec3 color_linear{1.0f};
+  double intensity = 1.0;
+  double range = 0.0;            ///< point, spot: distance where the light ends; 0 = infinite
+  double inner_cone_deg = 0.0;   ///< spot: full intensity inside this angle from the axis
+  double outer_cone_deg = 45.0;  ///< spot: no light outside it
+};
+
+/// Where a lit mesh's normals come from.
+enum class NormalSource : std::uint8_t {
+  File,    ///< the file's (glTF NORMAL, OBJ vn); per face where a corner has none
+  Flat,    ///< the face normal of every triangle
+  Smooth,  ///< area-weighted average of the face normals at each welded position
+};
+
 /// Triangle geometry shared by every instance that names the same file.
 struct MeshData {
   std::string source;                    ///< file it came from (for messages)
@@ -37,6 +82,14 @@ struct MeshData {
   std::vector<glm::vec3> colors_linear;  ///< per vertex, linear light; empty if none
   std::vector<std::uint32_t> indices;    ///< 3 per triangle, in file order after fan split
   std::size_t triangle_count() const { return indices.size() / 3; }
+  /// Object-space normals, 3 per triangle in index order (a corner of one position may
+  /// differ between faces, as OBJ's vn allows); empty if the file has none. A zero vector
+  /// means "no normal here": that triangle uses its face normal.
+  std::vector<glm::vec3> corner_normals;
+  /// The file's materials (glTF materials; empty for OBJ) and each triangle's index into
+  /// them (empty: every triangle uses materials[0], or the default material if none).
+  std::vector<Material> materials;
+  std::vector<std::uint32_t> triangle_materials;
 
   // Filled by analyze_mesh_topology (load_mesh and load_scene call it); the defaults mean
   // "not known to be closed", which disables back-face culling for the mesh.
@@ -61,6 +114,10 @@ struct MeshData {
 /// (that sign is closed_orientation). O(n log n) in the triangle count; call it on meshes built
 /// in code to enable culling for them.
 void analyze_mesh_topology(MeshData& mesh);
+/// Area-weighted vertex normals over the positions welded by equality, as corner normals
+/// (3 per triangle): what NormalSource::Smooth uses.
+std::vector<glm::vec3> smooth_corner_normals(const MeshData& mesh);
+
 /// Largest vertex count analyze_mesh_topology tests for convexity (the test is O(faces x
 /// vertices)).
 inline constexpr std::size_t kMaxConvexTestVertices = 4096;
@@ -78,6 +135,14 @@ struct MeshInstance {
   glm::vec3 color_linear{1.0f};  ///< for ColorSource::Uniform
   /// For Vertex colours coming from glTF: baseColorFactor, multiplied in (linear).
   glm::vec3 color_factor_linear{1.0f};
+  /// The instance's materials: the file's (or one default) with the scene's "material" keys
+  /// applied; one per MeshData::materials entry (empty: one Material{}). Used only when
+  /// Scene::lit.
+  std::vector<Material> materials;
+  NormalSource normals = NormalSource::File;
+  /// The corner normals this instance uses (MeshData::corner_normals, or the smoothed ones);
+  /// null for flat normals.
+  std::shared_ptr<const std::vector<glm::vec3>> corner_normals;
 };
 
 struct Scene {
@@ -87,6 +152,10 @@ struct Scene {
   glm::vec3 background_linear{0.0f};
   Camera camera;
   std::vector<MeshInstance> meshes;
+  /// A scene with a "lights" key is lit (even with an empty list: then only emission
+  /// shows); without one every mesh renders unlit, exactly as before lighting existed.
+  bool lit = false;
+  std::vector<Light> lights;
   /// Triangles dropped at load time because a vertex had a NaN or infinite coordinate.
   std::size_t dropped_nonfinite_triangles = 0;
   /// One line each, e.g. "meshes/a.obj: dropped 3 triangles with NaN/Inf coordinates".

@@ -1,5 +1,6 @@
 // Shading shared by every raster mode: flat, unlit colour, perspective-correct
-// interpolation of vertex colours in linear light.
+// interpolation of vertex colours in linear light, and for lit triangles (those with a
+// ShadingRecord) the lighting of docs/shading.md at the interpolated position and normal.
 #pragma once
 
 #include "core/triangle_setup.hpp"
@@ -7,6 +8,11 @@
 #include <algorithm>
 
 namespace covrast::detail {
+
+/// The lit colour of `t` at the perspective-correct barycentric weights mu0..mu2 (summing
+/// to 1): base colour, position and normal interpolated with them (the normal renormalised),
+/// then the material's lighting (core/shading.cpp). Out of line: it is the slow path.
+glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2);
 
 /// Colour of `t` at (x_px, y_px). With `clamp_inside`, barycentric weights are clamped to
 /// [0, 1] and renormalised, so a point outside the triangle takes the colour of the
@@ -30,10 +36,11 @@ inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool cl
   }
   double p0 = l0 * t.inv_w[0], p1 = l1 * t.inv_w[1], p2 = l2 * t.inv_w[2];
   double sum = p0 + p1 + p2;
-  if (!(sum > 0.0)) return t.color[0];
+  if (!(sum > 0.0)) return t.shading != nullptr ? shade_lit(t, 1.0, 0.0, 0.0) : t.color[0];
   p0 /= sum;
   p1 /= sum;
   p2 /= sum;
+  if (t.shading != nullptr) return shade_lit(t, p0, p1, p2);
   return glm::vec3(float(p0 * t.color[0].r + p1 * t.color[1].r + p2 * t.color[2].r),
                    float(p0 * t.color[0].g + p1 * t.color[1].g + p2 * t.color[2].g),
                    float(p0 * t.color[0].b + p1 * t.color[1].b + p2 * t.color[2].b));

@@ -23,6 +23,8 @@ inline constexpr double kGuardBandPx = 16384.0;
 
 inline constexpr std::uint32_t kNoTriangle = 0xffffffffu;
 
+struct ShadingRecord;  // core/shading_inputs.hpp
+
 struct TriangleSetup {
   /// Vertices in 24.8 fixed point, ordered so that the doubled signed area
   /// (x1-x0)(y2-y0) - (x2-x0)(y1-y0) is positive (clockwise on screen, y down).
@@ -37,8 +39,11 @@ struct TriangleSetup {
   glm::vec3 color[3];       ///< linear light per vertex (all equal when flat)
   std::uint32_t primitive;  ///< global triangle index in submission order (draw order)
   std::uint32_t surface;    ///< mesh instance index: fragments of one surface may merge
-  bool front_facing;        ///< counter-clockwise in NDC (OpenGL convention)
-  bool flat_color;          ///< color[0] == color[1] == color[2]
+  /// Lit triangles only: what shade() needs besides the colours (world-space positions and
+  /// normals, material, lights), written by the front end; null = unlit, colour as is.
+  const ShadingRecord* shading = nullptr;
+  bool front_facing;  ///< counter-clockwise in NDC (OpenGL convention)
+  bool flat_color;    ///< color[0] == color[1] == color[2] and unlit
   /// Of a convex mesh under an affine model matrix: triangles of one surface and facing with
   /// this flag never overlap on screen (the A-buffer skips their overlap test).
   bool convex_surface;
@@ -48,6 +53,9 @@ struct TriangleSetup {
            dzdy * (y_px - y_fx8[0] * (1.0 / kSubpixelOne));
   }
 };
+
+// Two cache lines at most: the tile loop prefetches exactly two lines per triangle.
+static_assert(sizeof(TriangleSetup) <= 128);
 
 /// Pixel bounds [x0, x1) x [y0, y1).
 struct PixelRect {

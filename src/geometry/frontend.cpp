@@ -22,6 +22,7 @@ namespace {
 struct ClipVertex {
   glm::dvec4 position;
   glm::vec3 color;
+  ShadeVertex shade;  ///< lit triangles only
 };
 
 /// Up to 3 + 6 planes' worth of vertices after Sutherland-Hodgman.
@@ -174,6 +175,79 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       vertices_[i].color_linear.resize(scene.meshes[i].mesh->positions.size());
     }
   }
+  if (scene.lit) prepare_lighting();
+}
+
+namespace {
+
+/// A scene light in the form shade() evaluates (core/shading_inputs.hpp); ambient lights
+/// are summed into the context instead.
+PunctualLight punctual_light(const Light& light) {
+  PunctualLight p;
+  p.radiance = glm::dvec3(light.color_linear) * light.intensity;
+  p.position = light.position;
+  p.inv_range = light.range > 0.0 ? 1.0 / light.range : 0.0;
+  switch (light.type) {
+    case LightType::Point:
+      p.kind = PunctualLight::Kind::Point;
+      break;
+    case LightType::Spot: {
+      p.kind = PunctualLight::Kind::Spot;
+      p.spot_axis = glm::normalize(light.direction);
+      const double cos_outer = std::cos(glm::radians(light.outer_cone_deg));
+      const double cos_inner = std::cos(glm::radians(light.inner_cone_deg));
+      p.cone_scale = 1.0 / std::max(0.001, cos_inner - cos_outer);
+      p.cone_offset = -cos_outer * p.cone_scale;
+      break;
+    }
+    default:
+      p.kind = PunctualLight::Kind::Directional;
+      p.to_light = -glm::normalize(light.direction);
+      break;
+  }
+  return p;
+}
+
+SurfaceShading surface_shading(const Material& m, const ShadingContext* context) {
+  SurfaceShading s;
+  s.model = LitModel(int(m.model));
+  s.metallic = m.metallic;
+  s.roughness = m.roughness;
+  s.emissive = glm::dvec3(m.emissive_linear);
+  s.specular = glm::dvec3(m.specular_linear);
+  s.shininess = m.shininess;
+  s.double_sided = m.double_sided;
+  s.context = context;
+  return s;
+}
+
+static_assert(int(ShadingModel::Unlit) == int(LitModel::Unlit) &&
+              int(ShadingModel::Lambert) == int(LitModel::Lambert) &&
+              int(ShadingModel::BlinnPhong) == int(LitModel::BlinnPhong) &&
+              int(ShadingModel::Pbr) == int(LitModel::Pbr));
+
+}  // namespace
+
+void GeometryFrontEnd::prepare_lighting() {
+  context_.eye_world = eye_;
+  for (const Light& light : scene_.lights) {
+    if (light.type == LightType::Ambient) {
+      context_.ambient += glm::dvec3(light.color_linear) * light.intensity;
+    } else {
+      context_.lights.push_back(punctual_light(light));
+    }
+  }
+  surfaces_.resize(scene_.meshes.size());
+  lit_.assign(scene_.meshes.size(), false);
+  for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
+    for (const Material& m : scene_.meshes[i].materials) {
+      surfaces_[i].push_back(surface_shading(m, &context_));
+      if (m.model != ShadingModel::Unlit) lit_[i] = true;
+    }
+    if (surfaces_[i].empty()) surfaces_[i].push_back(surface_shading(Material{}, &context_));
+    if (lit_[i]) vertices_[i].position_world.resize(scene_.meshes[i].mesh->positions.size());
+  }
+  chunk_shading_.resize(chunk_count());
 }
 
 unsigned GeometryFrontEnd::cullable_facing(const MeshInstance& instance, const glm::dvec3& eye) {
@@ -296,6 +370,11 @@ void GeometryFrontEnd::transform_vertices(std::size_t instance, std::size_t begi
     out.block_outcodes[block] = std::uint8_t(codes);
     block_begin = block_end;
   }
+  if (instance_lit(instance)) {
+    for (std::size_t v = begin; v < end; ++v) {
+      out.position_world[v] = glm::vec3(inst.model * glm::dvec4(glm::dvec3(positions[v]), 1.0));
+    }
+  }
   if (inst.color_source == ColorSource::Vertex) {
     const auto& colors = inst.mesh->colors_linear;
     for (std::size_t v = begin; v < end; ++v) {
@@ -358,6 +437,10 @@ TriangleSetup& ChunkSetups::grow() {
 void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   const std::uint64_t first = std::uint64_t(chunk) * kTrianglesPerChunk;
   const std::uint64_t last = std::min<std::uint64_t>(first + kTrianglesPerChunk, triangle_count());
+  if (!chunk_shading_.empty()) {
+    chunk_shading_[chunk].clear();
+    sink.shading = &chunk_shading_[chunk];
+  }
   // The instance holding `first`: first_triangle_ is sorted, find the last entry <= first.
   std::size_t instance =
       std::size_t(std::upper_bound(first_triangle_.begin(), first_triangle_.end(), first) -
@@ -372,6 +455,11 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
     sink.convex_surface = convex_surface(instance);
+    if (instance_lit(instance)) {
+      setup_lit_run(instance, g, run_end, sink);
+      g = run_end;
+      continue;
+    }
     const std::uint32_t* indices = inst.mesh->indices.data() + (g - first_triangle_[instance]) * 3;
     // A uniform colour is flat unless it is NaN (the per-triangle comparison's result).
     const glm::vec3 uniform = inst.color_linear;
@@ -425,7 +513,8 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
 [[gnu::always_inline]] inline void GeometryFrontEnd::emit_triangle(
     const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
     const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2, bool flat,
-    std::uint32_t primitive, std::uint32_t surface, Sink& sink) const {
+    std::uint32_t primitive, std::uint32_t surface, Sink& sink, const ShadeVertex* shade,
+    const SurfaceShading* lit, const LazyShade* lazy) const {
   const std::int64_t ax = v1.x_fx8 - v0.x_fx8, ay = v1.y_fx8 - v0.y_fx8;
   const std::int64_t bx = v2.x_fx8 - v0.x_fx8, by = v2.y_fx8 - v0.y_fx8;
   const std::int64_t area2 = ax * by - bx * ay;
@@ -498,15 +587,43 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.front_facing = front;
   t.flat_color = flat;
   t.convex_surface = sink.convex_surface;
+  t.shading = nullptr;
+  if (lit != nullptr) {
+    // Computed only now, for triangles that survived every cull (half of a closed mesh's
+    // are hidden back faces).
+    ShadeVertex computed[3];
+    if (lazy != nullptr) {
+      shade_vertices(lazy->instance, lazy->local, *lazy->normal_matrix, lazy->det_sign, computed);
+      shade = computed;
+    }
+    ShadingRecord& record = sink.shading->emplace_back();
+    // A back face (the file's counter-clockwise front turned away: clockwise on screen, or
+    // counter-clockwise under a mirroring model matrix) of a double-sided material is lit
+    // from the viewer's side: its normals flip (glTF 2.0, 3.9.5 doubleSided).
+    const float sign = lit->double_sided && front == sink.mirrored ? -1.0f : 1.0f;
+    const ShadeVertex* ordered[3] = {&shade[0], front ? &shade[2] : &shade[1],
+                                     front ? &shade[1] : &shade[2]};
+    for (int k = 0; k < 3; ++k) {
+      record.position_world[k] = ordered[k]->position_world;
+      record.normal_world[k] = sign * ordered[k]->normal_world;
+    }
+    record.surface = lit;
+    t.shading = &record;
+    t.flat_color = false;
+  }
 }
 
 void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp,
                                      const std::uint32_t* idx, const glm::vec3* color, bool flat,
-                                     unsigned out_any, std::uint32_t primitive, Sink& sink) const {
+                                     unsigned out_any, std::uint32_t primitive, Sink& sink,
+                                     const ShadeVertex* shade, const SurfaceShading* lit) const {
   const std::vector<glm::vec3>& positions = scene_.meshes[instance].mesh->positions;
   ++sink.counters.clipped;
   ClipPolygon poly, next;
-  for (int k = 0; k < 3; ++k) poly[k] = ClipVertex{clip_position(mvp, positions[idx[k]]), color[k]};
+  for (int k = 0; k < 3; ++k) {
+    poly[k] = ClipVertex{clip_position(mvp, positions[idx[k]]), color[k],
+                         shade != nullptr ? shade[k] : ShadeVertex{}};
+  }
   int count = 3;
   // Sutherland-Hodgman. The intersection on an edge is always computed from its inside
   // vertex towards its outside vertex, so that two triangles sharing the edge get the
@@ -528,6 +645,14 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
         const double t = din / (din - dout);
         next[n].position = in.position + t * (outv.position - in.position);
         next[n].color = in.color + float(t) * (outv.color - in.color);
+        // Attributes are affine in clip space, so the same t interpolates them.
+        if (shade != nullptr) {
+          const ShadeVertex &a_in = in.shade, &a_out = outv.shade;
+          next[n].shade.position_world =
+              a_in.position_world + float(t) * (a_out.position_world - a_in.position_world);
+          next[n].shade.normal_world =
+              a_in.normal_world + float(t) * (a_out.normal_world - a_in.normal_world);
+        }
         ++n;
       }
     }
@@ -546,8 +671,96 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
   }
   // Fan (0, k, k+1) over the clipped polygon.
   for (int k = 1; k + 1 < count; ++k) {
-    emit_triangle(s[0], s[k], s[k + 1], pc[0], pc[k], pc[k + 1], flat, primitive,
-                  std::uint32_t(instance), sink);
+    if (shade != nullptr) {
+      const ShadeVertex fan[3] = {poly[0].shade, poly[k].shade, poly[k + 1].shade};
+      emit_triangle(s[0], s[k], s[k + 1], pc[0], pc[k], pc[k + 1], flat, primitive,
+                    std::uint32_t(instance), sink, fan, lit);
+    } else {
+      emit_triangle(s[0], s[k], s[k + 1], pc[0], pc[k], pc[k + 1], flat, primitive,
+                    std::uint32_t(instance), sink);
+    }
+  }
+}
+
+void GeometryFrontEnd::shade_vertices(std::size_t instance, std::size_t local,
+                                      const glm::dmat3& normal_matrix, double det_sign,
+                                      ShadeVertex out[3]) const {
+  const MeshInstance& inst = scene_.meshes[instance];
+  const std::uint32_t* idx = inst.mesh->indices.data() + local * 3;
+  const std::vector<glm::vec3>& world = vertices_[instance].position_world;
+  // Face normal: the file's counter-clockwise side, cross(p1 - p0, p2 - p0) in world space,
+  // turned back by a mirroring model matrix (which reverses the world winding).
+  const glm::dvec3 w0(world[idx[0]]), w1(world[idx[1]]), w2(world[idx[2]]);
+  const glm::dvec3 face = glm::cross(w1 - w0, w2 - w0) * det_sign;
+  const double face_length = glm::length(face);
+  const glm::dvec3 face_unit = face_length > 0.0 ? face / face_length : glm::dvec3(0.0);
+  const glm::vec3* corners =
+      inst.corner_normals != nullptr ? inst.corner_normals->data() + local * 3 : nullptr;
+  for (int k = 0; k < 3; ++k) {
+    out[k].position_world = world[idx[k]];
+    glm::dvec3 n = face_unit;
+    if (corners != nullptr && corners[k] != glm::vec3(0.0f)) {
+      // Normals are covectors: n_world = M^-T n_object, renormalised.
+      const glm::dvec3 m = normal_matrix * glm::dvec3(corners[k]);
+      const double length = glm::length(m);
+      if (length > 0.0) n = m / length;
+    }
+    out[k].normal_world = glm::vec3(n);
+  }
+}
+
+void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end,
+                                     Sink& sink) const {
+  const MeshInstance& inst = scene_.meshes[instance];
+  const InstanceVertices& iv = vertices_[instance];
+  const glm::dmat4 mvp = view_projection_ * inst.model;
+  const glm::dmat3 linear(inst.model);
+  const double det = glm::determinant(linear);
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(linear));
+  const double det_sign = det < 0.0 ? -1.0 : 1.0;
+  sink.mirrored = det < 0.0;
+  const std::vector<SurfaceShading>& surfaces = surfaces_[instance];
+  const std::vector<std::uint32_t>& materials = inst.mesh->triangle_materials;
+  const std::uint64_t first = first_triangle_[instance];
+  for (; g < end; ++g) {
+    const std::size_t local = std::size_t(g - first);
+    const std::uint32_t* indices = inst.mesh->indices.data() + local * 3;
+    const auto primitive = std::uint32_t(g);
+    const std::size_t m = local < materials.size() ? materials[local] : 0;
+    const SurfaceShading* lit = &surfaces[m < surfaces.size() ? m : 0];
+    // The colours exactly as on the unlit path: they are the base colour.
+    glm::vec3 color[3];
+    switch (inst.color_source) {
+      case ColorSource::Uniform:
+        color[0] = color[1] = color[2] = inst.color_linear;
+        break;
+      case ColorSource::PerTriangle:
+        color[0] = color[1] = color[2] = per_triangle_color_linear(primitive);
+        break;
+      case ColorSource::Vertex:
+      default:
+        for (int k = 0; k < 3; ++k) color[k] = iv.color_linear[indices[k]];
+        break;
+    }
+    const bool flat = color[0] == color[1] && color[0] == color[2];
+    const unsigned o0 = iv.outcode[indices[0]], o1 = iv.outcode[indices[1]],
+                   o2 = iv.outcode[indices[2]];
+    if ((o0 & o1 & o2) != 0) {
+      ++sink.counters.culled;
+      continue;
+    }
+    const bool unlit = lit->model == LitModel::Unlit;
+    if ((o0 | o1 | o2) == 0) {
+      const LazyShade lazy{instance, local, &normal_matrix, det_sign};
+      emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]],
+                    color[0], color[1], color[2], flat, primitive, std::uint32_t(instance), sink,
+                    nullptr, unlit ? nullptr : lit, &lazy);
+    } else {
+      ShadeVertex shade[3];
+      if (!unlit) shade_vertices(instance, local, normal_matrix, det_sign, shade);
+      clip_triangle(instance, mvp, indices, color, flat, o0 | o1 | o2, primitive, sink,
+                    unlit ? nullptr : shade, unlit ? nullptr : lit);
+    }
   }
 }
 

@@ -9,6 +9,7 @@
 // constructor in frontend.cpp for why that never changes the image).
 #pragma once
 
+#include "core/shading_inputs.hpp"
 #include "core/triangle_setup.hpp"
 
 #include <covrast/scene.hpp>
@@ -44,9 +45,10 @@ struct SnappedVertex {
 /// 250k vertices, written every frame): the few triangles that need clipping recompute theirs
 /// with clip_position, bit for bit the values the outcodes came from.
 struct InstanceVertices {
-  std::vector<std::uint8_t> outcode;    ///< bit p set: outside clip plane p
-  std::vector<SnappedVertex> snapped;   ///< valid where outcode == 0
-  std::vector<glm::vec3> color_linear;  ///< only for ColorSource::Vertex
+  std::vector<std::uint8_t> outcode;      ///< bit p set: outside clip plane p
+  std::vector<SnappedVertex> snapped;     ///< valid where outcode == 0
+  std::vector<glm::vec3> color_linear;    ///< only for ColorSource::Vertex
+  std::vector<glm::vec3> position_world;  ///< only for lit instances: model * position
   /// Per kVerticesPerTransformBlock vertices: the union (OR) of their outcodes. Each slot is
   /// written by one transform call, so the per-instance union is race-free and deterministic.
   std::vector<std::uint8_t> block_outcodes;
@@ -104,6 +106,32 @@ class ChunkSetups {
   std::unique_ptr<TriangleSetup[]> overflow_;  ///< data_ once the slice ran full
 };
 
+/// A lit triangle's vertex as shading needs it: world position and unit normal (or any
+/// length after clipping; shade() renormalises after interpolation).
+struct ShadeVertex {
+  glm::vec3 position_world;
+  glm::vec3 normal_world;
+};
+
+/// One chunk's ShadingRecords: fixed blocks, so a record's address (TriangleSetup::shading)
+/// stays valid while more are added; the blocks are kept from frame to frame.
+class ShadingArena {
+ public:
+  void clear() { size_ = 0; }
+  ShadingRecord& emplace_back() {
+    const std::size_t block = size_ / kBlockRecords;
+    if (block == blocks_.size())
+      blocks_.push_back(std::make_unique<ShadingRecord[]>(kBlockRecords));
+    return blocks_[block][size_++ % kBlockRecords];
+  }
+  std::size_t size() const { return size_; }
+
+ private:
+  static constexpr std::size_t kBlockRecords = 4096;  ///< 320 KiB per block
+  std::vector<std::unique_ptr<ShadingRecord[]>> blocks_;
+  std::size_t size_ = 0;
+};
+
 struct SetupCounters {
   std::uint64_t culled = 0;           ///< outside the view volume, zero area after snapping, or a
                                       ///< hidden back face
@@ -137,7 +165,13 @@ class GeometryFrontEnd {
     return vertices_[instance];
   }
 
-  /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order.
+  /// Whether an instance is lit: the scene has lights and some material of the instance is
+  /// not ShadingModel::Unlit. Unlit instances take the unlit path bit for bit.
+  bool instance_lit(std::size_t instance) const { return !lit_.empty() && lit_[instance]; }
+
+  /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order. The
+  /// ShadingRecords of its lit triangles live in the front end until the same chunk is set up
+  /// again.
   void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
                    SetupCounters& counters) const;
   /// The same into a ChunkSetups (the pipeline's form, started over with reset() by the
@@ -160,18 +194,42 @@ class GeometryFrontEnd {
     /// Facings dropped as hidden back faces for the current instance: kDropClockwise,
     /// kDropCounterClockwise or 0.
     unsigned drop_facing = 0;
-    bool convex_surface = false;  ///< the instance's TriangleSetup::convex_surface
+    bool convex_surface = false;      ///< the instance's TriangleSetup::convex_surface
+    ShadingArena* shading = nullptr;  ///< where lit triangles' records go
+    /// The instance's model matrix has a negative determinant: its front faces (counter-
+    /// clockwise in the file) are clockwise on screen.
+    bool mirrored = false;
     /// A new triangle at the end of the output, its fields to be written.
     TriangleSetup& next() { return chunk != nullptr ? chunk->emplace_back() : out->emplace_back(); }
   };
+  /// Where emit_triangle computes a lit triangle's ShadeVertex (shade_vertices' arguments).
+  struct LazyShade {
+    std::size_t instance;
+    std::size_t local;
+    const glm::dmat3* normal_matrix;
+    double det_sign;
+  };
+  /// `lit`: a lit triangle's material, null for unlit ones; its ShadeVertex of v0, v1, v2 are
+  /// `shade`, or computed from `lazy` once the triangle has passed the culls.
   void emit_triangle(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
                      const glm::vec3& color0, const glm::vec3& color1, const glm::vec3& color2,
-                     bool flat, std::uint32_t primitive, std::uint32_t surface, Sink& sink) const;
+                     bool flat, std::uint32_t primitive, std::uint32_t surface, Sink& sink,
+                     const ShadeVertex* shade = nullptr, const SurfaceShading* lit = nullptr,
+                     const LazyShade* lazy = nullptr) const;
   /// `mvp`: view_projection_ times the instance's model matrix, as in transform_vertices.
   void clip_triangle(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
                      const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,
-                     Sink& sink) const;
+                     Sink& sink, const ShadeVertex* shade = nullptr,
+                     const SurfaceShading* lit = nullptr) const;
   void setup_range(std::uint32_t chunk, Sink& sink) const;
+  /// The triangles [g, end) of a lit instance (setup_range's loop with shading inputs).
+  void setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end, Sink& sink) const;
+  /// The three ShadeVertex of triangle `local` of a lit instance (`normal_matrix`: the
+  /// inverse transpose of the model matrix's 3x3 part, `det_sign` the sign of its determinant).
+  void shade_vertices(std::size_t instance, std::size_t local, const glm::dmat3& normal_matrix,
+                      double det_sign, ShadeVertex out[3]) const;
+  /// Builds context_, surfaces_ and lit_ from the scene (constructor, lit scenes only).
+  void prepare_lighting();
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
   /// Whether an instance's triangles are of a convex surface (TriangleSetup::convex_surface):
@@ -198,6 +256,12 @@ class GeometryFrontEnd {
   std::vector<InstanceVertices> vertices_;
   bool cull_hidden_backfaces_;
   glm::dvec3 eye_;  ///< the camera position the view matrix was built from [world]
+  // Lighting (empty for unlit scenes). surfaces_[i][m]: instance i's material m, pointing at
+  // context_; chunk_shading_[c]: the records of chunk c, written only by setup_chunk(c).
+  ShadingContext context_;
+  std::vector<std::vector<SurfaceShading>> surfaces_;
+  std::vector<bool> lit_;
+  mutable std::vector<ShadingArena> chunk_shading_;
 };
 
 }  // namespace covrast::detail

@@ -55,17 +55,26 @@ std::size_t drop_nonfinite_triangles(MeshData& mesh) {
   if (!any_bad) return 0;
   std::size_t kept = 0;
   std::size_t dropped = 0;
+  const bool normals = !mesh.corner_normals.empty();
+  const bool materials = !mesh.triangle_materials.empty();
   for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
     const std::uint32_t a = mesh.indices[t], b = mesh.indices[t + 1], c = mesh.indices[t + 2];
     if (bad[a] || bad[b] || bad[c]) {
       ++dropped;
       continue;
     }
+    // The per-triangle arrays move with their triangle (kept is 3 x the triangles kept).
+    if (normals)
+      std::copy_n(mesh.corner_normals.begin() + std::ptrdiff_t(t), 3,
+                  mesh.corner_normals.begin() + std::ptrdiff_t(kept));
+    if (materials) mesh.triangle_materials[kept / 3] = mesh.triangle_materials[t / 3];
     mesh.indices[kept++] = a;
     mesh.indices[kept++] = b;
     mesh.indices[kept++] = c;
   }
   mesh.indices.resize(kept);
+  if (normals) mesh.corner_normals.resize(kept);
+  if (materials) mesh.triangle_materials.resize(kept / 3);
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     if (bad[i]) mesh.positions[i] = glm::vec3(0.0f);
   }

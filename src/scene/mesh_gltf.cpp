@@ -295,6 +295,71 @@ float clamp_unit(double value) {
   return value >= 1.0 ? 1.0f : static_cast<float>(value);
 }
 
+/// A number of an extension object ("emissiveStrength" of KHR_materials_emissive_strength),
+/// or `fallback`.
+double extension_number(const tinygltf::ExtensionMap& extensions, const char* extension,
+                        const char* key, double fallback) {
+  const auto it = extensions.find(extension);
+  if (it == extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
+  const tinygltf::Value& value = it->second.Get(key);
+  return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
+}
+
+/// A glTF material as covrast shades it (glTF 2.0, 3.9 and 5.19; factors only, textures are
+/// the next step): pbrMetallicRoughness' metallic and roughness factors, emissiveFactor x
+/// KHR_materials_emissive_strength, doubleSided; KHR_materials_unlit selects ShadingModel::
+/// Unlit. The base colour factor goes into the colour selection, as unlit.
+Material convert_material(const tinygltf::Material& source) {
+  Material m;
+  m.model =
+      source.extensions.count("KHR_materials_unlit") != 0 ? ShadingModel::Unlit : ShadingModel::Pbr;
+  m.metallic = clamp_unit(source.pbrMetallicRoughness.metallicFactor);
+  m.roughness = clamp_unit(source.pbrMetallicRoughness.roughnessFactor);
+  const double strength = extension_number(source.extensions, "KHR_materials_emissive_strength",
+                                           "emissiveStrength", 1.0);
+  const double scale = std::isfinite(strength) && strength > 0.0 ? strength : 0.0;
+  if (source.emissiveFactor.size() == 3) {
+    for (int c = 0; c < 3; ++c) {
+      m.emissive_linear[c] =
+          static_cast<float>(clamp_unit(source.emissiveFactor[std::size_t(c)]) * scale);
+    }
+  }
+  m.double_sided = source.doubleSided;
+  // emissiveFactor scales the emissive texture (3.9.4); without textures a factor of 1 would
+  // turn the whole surface into a lamp (DamagedHelmet), so the emission is left out and
+  // counted (LoadedMesh::lit_warnings).
+  if (source.emissiveTexture.index >= 0) m.emissive_linear = glm::vec3(0.0f);
+  return m;
+}
+
+/// Normals of one primitive in the node's world space: n_world = normalize(M^-T n) for the
+/// upper 3x3 M of the node's matrix (normals are covectors).
+std::vector<glm::vec3> world_normals(const std::vector<double>& values, const glm::dmat4& world) {
+  const glm::dmat3 normal_matrix = glm::transpose(glm::inverse(glm::dmat3(world)));
+  std::vector<glm::vec3> normals(values.size() / 3, glm::vec3(0.0f));
+  for (std::size_t v = 0; v < normals.size(); ++v) {
+    const glm::dvec3 n =
+        normal_matrix * glm::dvec3(values[3 * v], values[3 * v + 1], values[3 * v + 2]);
+    const double length = glm::length(n);
+    if (length > 0.0 && std::isfinite(length)) normals[v] = glm::vec3(n / length);
+  }
+  return normals;
+}
+
+/// The primitive's NORMAL attribute in world space, or empty when it has none.
+std::vector<glm::vec3> primitive_normals(const Reader& reader, const tinygltf::Primitive& primitive,
+                                         const std::string& what, const glm::dmat4& world,
+                                         std::size_t vertex_count) {
+  const auto it = primitive.attributes.find("NORMAL");
+  if (it == primitive.attributes.end()) return {};
+  int components = 0;
+  const std::vector<double> values = reader.read_accessor(what + " NORMAL", it->second, components);
+  if (components != 3) fail(reader.name, what + ": NORMAL must be VEC3");
+  if (values.size() / 3 != vertex_count)
+    fail(reader.name, what + ": NORMAL and POSITION counts differ");
+  return world_normals(values, world);
+}
+
 }  // namespace
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
@@ -342,6 +407,15 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
 
   auto mesh = std::make_shared<MeshData>();
   mesh->source = display_name;
+  // The file's materials, then glTF's default material for primitives without one.
+  std::size_t emissive_textures = 0;
+  for (const tinygltf::Material& material : model.materials) {
+    mesh->materials.push_back(convert_material(material));
+    if (material.emissiveTexture.index >= 0) ++emissive_textures;
+  }
+  mesh->materials.push_back(convert_material(tinygltf::Material{}));
+  const auto default_material = static_cast<std::uint32_t>(model.materials.size());
+  bool any_normals = false;
   std::vector<glm::vec3> colors;  // per vertex: COLOR_0 x factor, or the factor alone
   bool any_color_attribute = false;
   bool any_primitive = false;
@@ -442,6 +516,10 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
         colors.insert(colors.end(), vertex_count, factor_clamped);
       }
 
+      // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
+      // clockwise; swapping two corners keeps counter-clockwise = front after baking.
+      const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
+      const std::size_t first_index = mesh->indices.size();
       if (primitive.indices >= 0) {
         int index_components = 0;
         const std::vector<double> indices =
@@ -474,10 +552,37 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
           mesh->indices.push_back(static_cast<std::uint32_t>(base + v));
         }
       }
+      if (mirrored) {
+        for (std::size_t i = first_index; i < mesh->indices.size(); i += 3) {
+          std::swap(mesh->indices[i + 1], mesh->indices[i + 2]);
+        }
+      }
+      const std::uint32_t material = primitive.material >= 0
+                                         ? static_cast<std::uint32_t>(primitive.material)
+                                         : default_material;
+      mesh->triangle_materials.resize(mesh->indices.size() / 3, material);
+      const std::vector<glm::vec3> normals =
+          primitive_normals(reader, primitive, what, world, vertex_count);
+      if (!normals.empty() && !any_normals) {
+        // Triangles before the first primitive with NORMAL: no normal (face normals).
+        mesh->corner_normals.assign(first_index, glm::vec3(0.0f));
+        any_normals = true;
+      }
+      if (any_normals) {
+        for (std::size_t i = first_index; i < mesh->indices.size(); ++i) {
+          mesh->corner_normals.push_back(normals.empty() ? glm::vec3(0.0f)
+                                                         : normals[mesh->indices[i] - base]);
+        }
+      }
     }
   }
 
   LoadedMesh loaded;
+  if (emissive_textures > 0) {
+    loaded.lit_warnings.push_back(name + ": " + std::to_string(emissive_textures) +
+                                  " materials with an emissive texture: textures are not "
+                                  "rendered yet, their emission is left out");
+  }
   if (any_color_attribute || factors_differ) {
     // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
     mesh->colors_linear = std::move(colors);

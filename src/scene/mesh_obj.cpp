@@ -1,9 +1,11 @@
-// Wavefront OBJ reader for the subset covrast renders: "v x y z [r g b]" and "f" with any index
-// form (i, i/t, i//n, i/t/n; negative = relative to the vertices defined so far). Polygons become
-// the fan (0, k, k + 1), k = 1 .. n - 2, triangles in file order. Everything else (vt, vn, o, g,
+// Wavefront OBJ reader for the subset covrast renders: "v x y z [r g b]", "vn x y z" and "f"
+// with any index form (i, i/t, i//n, i/t/n; negative = relative to the vertices or normals
+// defined so far). Polygons become the fan (0, k, k + 1), k = 1 .. n - 2, triangles in file
+// order; normals become corner normals (MeshData::corner_normals). Everything else (vt, o, g,
 // s, usemtl, mtllib, l, ...) is ignored, so a missing .mtl file never matters.
 #include "scene/scene_internal.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdint>
 #include <cstdlib>
@@ -88,6 +90,49 @@ std::string out_of_range(long long index, std::size_t vertex_count) {
          " vertices)";
 }
 
+/// The normal index of a face corner "i/t/n" or "i//n", 1-based (negative = relative to the
+/// normals read so far), resolved to 0-based but not yet checked against the count: normals
+/// may be defined after the faces that use them, like vertices. kNoNormal when the corner
+/// gives none.
+constexpr long long kNoNormal = std::numeric_limits<long long>::min();
+long long corner_normal(std::string_view token, std::size_t normal_count, const std::string& name,
+                        std::size_t line) {
+  const std::size_t first = token.find('/');
+  if (first == std::string_view::npos) return kNoNormal;
+  const std::size_t second = token.find('/', first + 1);
+  if (second == std::string_view::npos) return kNoNormal;
+  long long index = 0;
+  if (!parse_integer(token.substr(second + 1), index)) {
+    fail(name, line, "bad face vertex '" + printable(token) + "'");
+  }
+  // 0 and indices before the first normal can never exist: -1 stands for "missing".
+  if (index > 0) return index - 1;
+  const long long resolved = static_cast<long long>(normal_count) + index;
+  return index < 0 && resolved >= 0 ? resolved : -1;
+}
+
+/// Corner normals from the resolved indices; a reference to a normal that does not exist
+/// gives no normal there (that face uses its face normal), counted in a warning.
+void resolve_corner_normals(const std::vector<long long>& refs,
+                            const std::vector<glm::vec3>& normals, const std::string& name,
+                            LoadedMesh& loaded) {
+  std::size_t missing = 0;
+  std::vector<glm::vec3>& out = loaded.data->corner_normals;
+  out.assign(refs.size(), glm::vec3(0.0f));
+  for (std::size_t c = 0; c < refs.size(); ++c) {
+    if (refs[c] == kNoNormal) continue;
+    if (refs[c] >= 0 && static_cast<std::size_t>(refs[c]) < normals.size()) {
+      out[c] = normals[static_cast<std::size_t>(refs[c])];
+    } else {
+      ++missing;
+    }
+  }
+  if (missing > 0) {
+    loaded.warnings.push_back(name + ": " + std::to_string(missing) +
+                              " face corners reference normals that do not exist (" +
+                              std::to_string(normals.size()) + " vn lines); face normals used");
+  }
+}
 }  // namespace
 
 LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
@@ -96,6 +141,10 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
   std::vector<glm::vec3> colors_srgb;  // one per vertex, white where the file gives none
   bool any_color = false;
   std::vector<std::uint32_t> corners;
+  std::vector<glm::vec3> normals;         // vn lines, in file order
+  std::vector<long long> corner_normals;  // of the current face: see corner_normal()
+  std::vector<long long> normal_refs;     // per triangle corner, as corner_normals
+  bool any_face_normal = false;
   // Positive indices may point past the vertices read so far (OBJ does not forbid forward
   // references); the largest one is checked against the final count at the end.
   long long max_forward_index = 0;
@@ -138,8 +187,22 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
       colors_srgb.emplace_back(static_cast<float>(values[3]), static_cast<float>(values[4]),
                                static_cast<float>(values[5]));
       if (count < 6) colors_srgb.back() = glm::vec3(1.0f);
+    } else if (keyword == "vn") {
+      double values[3] = {0.0, 0.0, 0.0};
+      int count = 0;
+      std::string_view token;
+      while (tokens.next(token)) {
+        if (count < 3 && !parse_double(token, values[count])) {
+          fail(display_name, line_no, "bad number '" + printable(token) + "'");
+        }
+        ++count;
+      }
+      if (count != 3) fail(display_name, line_no, "normal needs x y z");
+      normals.emplace_back(static_cast<float>(values[0]), static_cast<float>(values[1]),
+                           static_cast<float>(values[2]));
     } else if (keyword == "f") {
       corners.clear();
+      corner_normals.clear();
       const auto vertex_count = static_cast<long long>(mesh->positions.size());
       std::string_view token;
       while (tokens.next(token)) {
@@ -166,15 +229,24 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
           fail(display_name, line_no, out_of_range(index, mesh->positions.size()));
         }
         corners.push_back(static_cast<std::uint32_t>(resolved));
+        corner_normals.push_back(corner_normal(token, normals.size(), display_name, line_no));
       }
       if (corners.size() < 3) {
         fail(display_name, line_no,
              "face needs at least 3 vertices, got " + std::to_string(corners.size()));
       }
+      const bool face_normals = std::any_of(corner_normals.begin(), corner_normals.end(),
+                                            [](long long n) { return n != kNoNormal; });
+      if (face_normals && !any_face_normal) {
+        // Faces before the first with normals: none (the face normal).
+        normal_refs.assign(mesh->indices.size(), kNoNormal);
+        any_face_normal = true;
+      }
       for (std::size_t k = 1; k + 1 < corners.size(); ++k) {
-        mesh->indices.push_back(corners[0]);
-        mesh->indices.push_back(corners[k]);
-        mesh->indices.push_back(corners[k + 1]);
+        for (const std::size_t c : {std::size_t(0), k, k + 1}) {
+          mesh->indices.push_back(corners[c]);
+          if (any_face_normal) normal_refs.push_back(corner_normals[c]);
+        }
       }
     }
   }
@@ -190,6 +262,8 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
     }
   }
   LoadedMesh loaded;
+  loaded.data = mesh;
+  if (any_face_normal) resolve_corner_normals(normal_refs, normals, display_name, loaded);
   loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
   analyze_mesh_topology(*mesh);  // once per file: instances share the result
   loaded.data = std::move(mesh);

@@ -10,6 +10,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace covrast::detail {
 
@@ -22,6 +23,10 @@ struct LoadedMesh {
   glm::vec3 uniform_color_linear{1.0f};
   /// Triangles removed because one of their vertices had a NaN or infinite coordinate.
   std::size_t dropped_nonfinite_triangles = 0;
+  /// What the file holds that covrast does not render, one line each (Scene::warnings).
+  std::vector<std::string> warnings;
+  /// The same, for what matters only when the scene is lit (materials).
+  std::vector<std::string> lit_warnings;
 };
 
 /// Reads a whole file. On failure returns false and sets `error` to the system's reason

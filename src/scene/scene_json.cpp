@@ -195,7 +195,152 @@ class SceneReader {
     return model;
   }
 
+  /// A number in [lo, hi].
+  double number_in(const json& value, const std::string& path, double lo, double hi) const {
+    const double x = number(value, path);
+    if (x < lo || x > hi) {
+      fail(file_, path,
+           "expected a number in " + number_text(lo) + ".." + number_text(hi) + ", got " +
+               shown(value));
+    }
+    return x;
+  }
+
+  /// [r,g,b] of linear light, each finite and >= 0 (light colours may exceed 1).
+  glm::vec3 linear_color(const json& value, const std::string& path) const {
+    if (!value.is_array() || value.size() != 3) {
+      fail(file_, path, "expected [r,g,b], got " + shown(value));
+    }
+    glm::vec3 color(0.0f);
+    for (std::size_t c = 0; c < 3; ++c) {
+      const std::string component_path = path + "[" + std::to_string(c) + "]";
+      const double x = number(value[c], component_path);
+      if (x < 0.0) fail(file_, component_path, "must be >= 0, got " + shown(value[c]));
+      color[static_cast<int>(c)] = static_cast<float>(x);
+    }
+    return color;
+  }
+
+  /// A non-zero direction, normalised.
+  glm::dvec3 direction(const json& value, const std::string& path) const {
+    const glm::dvec3 d = vec3(value, path);
+    const double length = glm::length(d);
+    if (!(length > 0.0) || !std::isfinite(length)) fail(file_, path, "must not be zero");
+    return d / length;
+  }
+
+  Light light(const json& value, const std::string& key) const {
+    const json& object = require_object(value, key);
+    const json& type = required(object, "type", key + ".type");
+    Light light;
+    if (type == "directional") {
+      light.type = LightType::Directional;
+    } else if (type == "point") {
+      light.type = LightType::Point;
+    } else if (type == "spot") {
+      light.type = LightType::Spot;
+    } else if (type == "ambient") {
+      light.type = LightType::Ambient;
+    } else {
+      fail(file_, key + ".type",
+           "expected \"directional\", \"point\", \"spot\" or \"ambient\", got " + shown(type));
+    }
+    if (const auto it = object.find("color"); it != object.end()) {
+      light.color_linear = linear_color(*it, key + ".color");
+    }
+    if (const auto it = object.find("intensity"); it != object.end()) {
+      light.intensity = number_in(*it, key + ".intensity", 0.0, 1e30);
+    }
+    if (light.type == LightType::Directional || light.type == LightType::Spot) {
+      light.direction =
+          direction(required(object, "direction", key + ".direction"), key + ".direction");
+    }
+    if (light.type == LightType::Point || light.type == LightType::Spot) {
+      light.position = vec3(required(object, "position", key + ".position"), key + ".position");
+      if (const auto it = object.find("range"); it != object.end()) {
+        light.range = number(*it, key + ".range");
+        if (!(light.range > 0.0)) fail(file_, key + ".range", "must be > 0, got " + shown(*it));
+      }
+    }
+    if (light.type == LightType::Spot) spot_cone(object, key, light);
+    return light;
+  }
+
+  /// KHR_lights_punctual: 0 <= inner < outer <= 90 degrees (defaults 0 and 45).
+  void spot_cone(const json& object, const std::string& key, Light& light) const {
+    if (const auto it = object.find("inner_cone_deg"); it != object.end()) {
+      light.inner_cone_deg = number_in(*it, key + ".inner_cone_deg", 0.0, 90.0);
+    }
+    if (const auto it = object.find("outer_cone_deg"); it != object.end()) {
+      light.outer_cone_deg = number_in(*it, key + ".outer_cone_deg", 0.0, 90.0);
+    }
+    if (!(light.inner_cone_deg < light.outer_cone_deg)) {
+      fail(file_, key + ".outer_cone_deg", "must be greater than inner_cone_deg");
+    }
+  }
+
+  std::vector<Light> lights(const json& value) const {
+    if (!value.is_array()) fail(file_, "lights", "expected an array, got " + shown(value));
+    std::vector<Light> result;
+    for (std::size_t i = 0; i < value.size(); ++i) {
+      result.push_back(light(value[i], "lights[" + std::to_string(i) + "]"));
+    }
+    return result;
+  }
+
+  ShadingModel shading_model(const json& value, const std::string& path) const {
+    if (value == "unlit") return ShadingModel::Unlit;
+    if (value == "lambert") return ShadingModel::Lambert;
+    if (value == "blinn-phong") return ShadingModel::BlinnPhong;
+    if (value == "pbr") return ShadingModel::Pbr;
+    fail(file_, path,
+         "expected \"unlit\", \"lambert\", \"blinn-phong\" or \"pbr\", got " + shown(value));
+  }
+
+  /// Applies the keys of a scene "material" object to `m` (keys not given keep its value).
+  void apply_material(const json& object, const std::string& key, Material& m) const {
+    if (const auto it = object.find("model"); it != object.end()) {
+      m.model = shading_model(*it, key + ".model");
+    }
+    if (const auto it = object.find("metallic"); it != object.end()) {
+      m.metallic = static_cast<float>(number_in(*it, key + ".metallic", 0.0, 1.0));
+    }
+    if (const auto it = object.find("roughness"); it != object.end()) {
+      m.roughness = static_cast<float>(number_in(*it, key + ".roughness", 0.0, 1.0));
+    }
+    if (const auto it = object.find("emissive"); it != object.end()) {
+      m.emissive_linear = srgb_color(*it, key + ".emissive");
+    }
+    if (const auto it = object.find("shininess"); it != object.end()) {
+      m.shininess = static_cast<float>(number_in(*it, key + ".shininess", 1e-3, 1e4));
+    }
+    if (const auto it = object.find("specular"); it != object.end()) {
+      m.specular_linear =
+          glm::vec3(static_cast<float>(number_in(*it, key + ".specular", 0.0, 1.0)));
+    }
+    if (const auto it = object.find("double_sided"); it != object.end()) {
+      if (!it->is_boolean()) {
+        fail(file_, key + ".double_sided", "expected true or false, got " + shown(*it));
+      }
+      m.double_sided = it->get<bool>();
+    }
+  }
+
+  NormalSource normal_source(const json& value, const std::string& path) const {
+    if (value == "file") return NormalSource::File;
+    if (value == "flat") return NormalSource::Flat;
+    if (value == "smooth") return NormalSource::Smooth;
+    fail(file_, path, "expected \"file\", \"flat\" or \"smooth\", got " + shown(value));
+  }
+
  private:
+  static std::string number_text(double x) {
+    std::string text = std::to_string(x);
+    while (text.back() == '0') text.pop_back();
+    if (text.back() == '.') text.pop_back();
+    return text;
+  }
+
   std::string file_;
 };
 
@@ -203,7 +348,57 @@ enum class MeshFormat { Obj, Gltf };
 
 struct CachedMesh {
   detail::LoadedMesh loaded;
+  /// The file's corner normals, shared by the instances that use them; the smoothed ones,
+  /// computed on first request.
+  std::shared_ptr<const std::vector<glm::vec3>> file_normals;
+  std::shared_ptr<const std::vector<glm::vec3>> smooth_normals;
 };
+
+/// The instance's materials: the file's, or one default (lambert for OBJ, which has none in
+/// covrast yet; glTF files always list theirs), with the scene's "material" keys applied.
+std::vector<Material> instance_materials(const SceneReader& reader, const json& entry,
+                                         const std::string& key, const MeshData& mesh) {
+  std::vector<Material> materials = mesh.materials;
+  if (materials.empty()) {
+    Material lambert;
+    lambert.model = ShadingModel::Lambert;
+    materials.push_back(lambert);
+  }
+  if (const auto it = entry.find("material"); it != entry.end()) {
+    const json& object = reader.require_object(*it, key + ".material");
+    for (Material& m : materials) reader.apply_material(object, key + ".material", m);
+  }
+  return materials;
+}
+
+/// NormalSource and the corner normals that go with it.
+void select_normals(const SceneReader& reader, const std::string& file, const json& entry,
+                    const std::string& key, const std::string& relative, CachedMesh& cached,
+                    MeshInstance& instance) {
+  const MeshData& mesh = *cached.loaded.data;
+  const bool has_normals = !mesh.corner_normals.empty();
+  instance.normals = has_normals ? NormalSource::File : NormalSource::Flat;
+  if (const auto it = entry.find("normals"); it != entry.end()) {
+    instance.normals = reader.normal_source(*it, key + ".normals");
+    if (instance.normals == NormalSource::File && !has_normals) {
+      fail(file, key + ".normals", "\"file\" but '" + relative + "' has no normals");
+    }
+  }
+  if (instance.normals == NormalSource::File) {
+    if (!cached.file_normals) {
+      // Aliasing: shares ownership of the mesh, points at its normals (no copy).
+      cached.file_normals = std::shared_ptr<const std::vector<glm::vec3>>(
+          cached.loaded.data, &cached.loaded.data->corner_normals);
+    }
+    instance.corner_normals = cached.file_normals;
+  } else if (instance.normals == NormalSource::Smooth) {
+    if (!cached.smooth_normals) {
+      cached.smooth_normals =
+          std::make_shared<const std::vector<glm::vec3>>(smooth_corner_normals(mesh));
+    }
+    instance.corner_normals = cached.smooth_normals;
+  }
+}
 
 }  // namespace
 
@@ -234,6 +429,10 @@ Scene load_scene(const std::filesystem::path& json_path) {
     scene.background_linear = reader.srgb_color(*it, "background");
   }
   scene.camera = reader.camera(root);
+  if (const auto it = root.find("lights"); it != root.end()) {
+    scene.lit = true;
+    scene.lights = reader.lights(*it);
+  }
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
@@ -285,13 +484,31 @@ Scene load_scene(const std::filesystem::path& json_path) {
           cache.emplace(std::make_pair(canonical.string(), format), std::move(entry_data)).first;
     }
     const detail::LoadedMesh& loaded = cached->second.loaded;
+    if (first_use) {
+      for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
+      if (scene.lit) {
+        for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
+      }
+    }
     // Counted per instance: each instance would have drawn the dropped triangles.
     scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
 
     MeshInstance instance;
     instance.mesh = loaded.data;
     const bool has_vertex_colors = !loaded.data->colors_linear.empty();
-    if (const auto color_it = entry.find("color"); color_it != entry.end()) {
+    // material.base_color is the same as "color": [r,g,b] (the base colour of a lit mesh is
+    // its colour selection).
+    const json* base_color = nullptr;
+    if (const auto it = entry.find("material"); it != entry.end() && it->is_object()) {
+      if (const auto bit = it->find("base_color"); bit != it->end()) base_color = &*bit;
+    }
+    const auto color_it = entry.find("color");
+    if (base_color != nullptr && color_it != entry.end()) {
+      fail(file, key + ".material.base_color", "give either it or \"color\", not both");
+    }
+    if (base_color != nullptr) {
+      instance.color_linear = reader.srgb_color(*base_color, key + ".material.base_color");
+    } else if (color_it != entry.end()) {
       const json& color = *color_it;
       const std::string color_key = key + ".color";
       if (color.is_array()) {
@@ -316,6 +533,8 @@ Scene load_scene(const std::filesystem::path& json_path) {
     if (const auto model_it = entry.find("model"); model_it != entry.end()) {
       instance.model = reader.model_matrix(*model_it, key + ".model");
     }
+    instance.materials = instance_materials(reader, entry, key, *loaded.data);
+    select_normals(reader, file, entry, key, relative, cached->second, instance);
     scene.meshes.push_back(std::move(instance));
   }
   return scene;

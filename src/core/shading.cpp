@@ -1,0 +1,173 @@
+// Lighting of lit triangles (docs/shading.md): the light models of covrast::ShadingModel
+// evaluated at one point, in double precision. Every raster mode reaches this through
+// shade() (core/shading.hpp), so all modes light a point alike; only where they evaluate
+// differs (pixel centre clamped into the triangle for coverage and msaa, every sample for
+// ssaa and reference).
+#include "core/shading.hpp"
+#include "core/shading_inputs.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace covrast::detail {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+/// Smallest BRDF roughness alpha (= perceptual roughness^2), see pbr_brdf.
+constexpr double kMinAlpha = 1e-3;
+
+/// What one punctual light delivers at a point: the unit direction towards it and the
+/// irradiance on a surface facing it, E = radiance x attenuation (KHR_lights_punctual).
+struct Incident {
+  glm::dvec3 l{0.0};
+  glm::dvec3 irradiance{0.0};
+};
+
+/// Directional: E = color x intensity. Point and spot: E = color x intensity / d^2 x
+/// clamp(1 - (d / range)^4, 0, 1) (the extension's recommended range window), spot also x
+/// clamp(cos(angle to axis) x scale + offset, 0, 1)^2.
+Incident incident(const PunctualLight& light, const glm::dvec3& p) {
+  if (light.kind == PunctualLight::Kind::Directional) return {light.to_light, light.radiance};
+  const glm::dvec3 d = light.position - p;
+  const double distance2 = glm::dot(d, d);
+  if (!(distance2 > 0.0)) return {};
+  const double distance = std::sqrt(distance2);
+  const glm::dvec3 l = d * (1.0 / distance);
+  double attenuation = 1.0 / distance2;
+  if (light.inv_range > 0.0) {
+    const double q = distance * light.inv_range;
+    const double q2 = q * q;
+    attenuation *= std::clamp(1.0 - q2 * q2, 0.0, 1.0);
+  }
+  if (light.kind == PunctualLight::Kind::Spot) {
+    const double cone =
+        std::clamp(-glm::dot(light.spot_axis, l) * light.cone_scale + light.cone_offset, 0.0, 1.0);
+    attenuation *= cone * cone;
+  }
+  return {l, light.radiance * attenuation};
+}
+
+/// (1 - x)^5 by multiplication (the Schlick weight).
+double schlick_weight(double cos_theta) {
+  const double m = std::clamp(1.0 - cos_theta, 0.0, 1.0);
+  const double m2 = m * m;
+  return m2 * m2 * m;
+}
+
+/// base x (ambient + sum_i E_i max(0, n . l_i)): Lambert without 1/pi, so that a light of
+/// intensity 1 facing the surface returns the base colour.
+glm::dvec3 diffuse_sum(const ShadingContext& c, const glm::dvec3& base, const glm::dvec3& p,
+                       const glm::dvec3& n) {
+  glm::dvec3 e = c.ambient;
+  for (const PunctualLight& light : c.lights) {
+    const Incident in = incident(light, p);
+    e += in.irradiance * std::max(0.0, glm::dot(n, in.l));
+  }
+  return base * e;
+}
+
+/// Blinn (1977) highlight: sum_i specular x E_i x max(0, n . h_i)^shininess where n . l_i > 0,
+/// h_i = normalize(l_i + v), unnormalised (specular is the peak's fraction of E).
+glm::dvec3 blinn_phong_highlights(const SurfaceShading& s, const glm::dvec3& p, const glm::dvec3& n,
+                                  const glm::dvec3& v) {
+  glm::dvec3 sum(0.0);
+  for (const PunctualLight& light : s.context->lights) {
+    const Incident in = incident(light, p);
+    if (!(glm::dot(n, in.l) > 0.0)) continue;
+    const glm::dvec3 h = in.l + v;
+    const double h_length = glm::length(h);
+    if (!(h_length > 0.0)) continue;
+    const double n_dot_h = std::max(0.0, glm::dot(n, h) / h_length);
+    sum += s.specular * in.irradiance * std::pow(n_dot_h, s.shininess);
+  }
+  return sum;
+}
+
+/// sum_i f(l_i, v) E_i (n . l_i)+ plus the ambient term ambient x ((1 - f0) c_diff + f0)
+/// (a uniform environment reflected by the normal-incidence albedo; a convention of
+/// covrast, not of the glTF specification, which has no ambient light).
+glm::dvec3 pbr_radiance(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
+                        const glm::dvec3& n, const glm::dvec3& v) {
+  const glm::dvec3 c_diff = base * (1.0 - s.metallic);
+  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - s.metallic) + base * s.metallic;
+  glm::dvec3 sum = s.context->ambient * ((glm::dvec3(1.0) - f0) * c_diff + f0);
+  for (const PunctualLight& light : s.context->lights) {
+    const Incident in = incident(light, p);
+    const double n_dot_l = glm::dot(n, in.l);
+    if (!(n_dot_l > 0.0)) continue;
+    sum += pbr_brdf(base, s.metallic, s.roughness, n, v, in.l) * in.irradiance * n_dot_l;
+  }
+  return sum;
+}
+
+}  // namespace
+
+// glTF 2.0 specification, Appendix B.3 (https://registry.khronos.org/glTF/specs/2.0/
+// glTF-2.0.html#appendix-b-brdf-implementation), the implementation form of B.3.5:
+//   alpha = max(roughness^2, 1e-3), c_diff = lerp(base, 0, metallic), f0 = lerp(0.04, base,
+//   metallic) F = f0 + (1 - f0) (1 - |v . h|)^5 D = alpha^2 X+(n . h) / (pi ((n . h)^2 (alpha^2 -
+//   1) + 1)^2) V = X+(h . l) / (|n . l| + sqrt(alpha^2 + (1 - alpha^2) (n . l)^2))
+//     x X+(h . v) / (|n . v| + sqrt(alpha^2 + (1 - alpha^2) (n . v)^2))
+//   f = (1 - F) c_diff / pi + F D V
+glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
+                    const glm::dvec3& v, const glm::dvec3& l) {
+  const glm::dvec3 c_diff = base * (1.0 - metallic);
+  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - metallic) + base * metallic;
+  // alpha = 0 (a perfect mirror) makes D = 0/0 where n = h: kept at kMinAlpha, a highlight
+  // one pixel wide that the resolve clamps.
+  const double alpha = std::max(roughness * roughness, kMinAlpha);
+  const double alpha2 = alpha * alpha;
+  const glm::dvec3 h_sum = l + v;
+  const double h_length = glm::length(h_sum);
+  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
+  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
+  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l), h_dot_v = glm::dot(h, v);
+  const glm::dvec3 fresnel = f0 + (glm::dvec3(1.0) - f0) * schlick_weight(std::abs(h_dot_v));
+  // D x V in one division: alpha^2 / (pi k^2 g_l g_v), k = (n.h)^2 (alpha^2 - 1) + 1.
+  double d_vis = 0.0;
+  if (n_dot_h > 0.0 && h_dot_l > 0.0 && h_dot_v > 0.0) {
+    const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
+    const double gl = n_dot_l + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_l * n_dot_l);
+    const double gv = n_dot_v + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_v * n_dot_v);
+    d_vis = alpha2 / (kPi * k * k * (gl * gv));
+  }
+  return (glm::dvec3(1.0) - fresnel) * c_diff * (1.0 / kPi) + fresnel * d_vis;
+}
+
+glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
+                       const glm::dvec3& n) {
+  const ShadingContext& c = *s.context;
+  const glm::dvec3 to_eye = c.eye_world - p;
+  const double eye_distance = glm::length(to_eye);
+  const glm::dvec3 v = eye_distance > 0.0 ? to_eye * (1.0 / eye_distance) : n;
+  switch (s.model) {
+    case LitModel::Unlit:
+      return base;
+    case LitModel::Lambert:
+      return diffuse_sum(c, base, p, n) + s.emissive;
+    case LitModel::BlinnPhong:
+      return diffuse_sum(c, base, p, n) + blinn_phong_highlights(s, p, n, v) + s.emissive;
+    case LitModel::Pbr:
+    default:
+      return pbr_radiance(s, base, p, n, v) + s.emissive;
+  }
+}
+
+glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+  const ShadingRecord& r = *t.shading;
+  // The same weighted sums as the unlit colour interpolation in shade().
+  const glm::dvec3 base(mu0 * t.color[0].r + mu1 * t.color[1].r + mu2 * t.color[2].r,
+                        mu0 * t.color[0].g + mu1 * t.color[1].g + mu2 * t.color[2].g,
+                        mu0 * t.color[0].b + mu1 * t.color[1].b + mu2 * t.color[2].b);
+  const glm::dvec3 p = mu0 * glm::dvec3(r.position_world[0]) +
+                       mu1 * glm::dvec3(r.position_world[1]) +
+                       mu2 * glm::dvec3(r.position_world[2]);
+  glm::dvec3 n = mu0 * glm::dvec3(r.normal_world[0]) + mu1 * glm::dvec3(r.normal_world[1]) +
+                 mu2 * glm::dvec3(r.normal_world[2]);
+  const double n_length = glm::length(n);
+  n = n_length > 0.0 ? n * (1.0 / n_length) : glm::dvec3(0.0);
+  return glm::vec3(shade_point(*r.surface, base, p, n));
+}
+
+}  // namespace covrast::detail

@@ -1,0 +1,73 @@
+// Shading inputs of lit triangles, built by the geometry front end (src/geometry/frontend.cpp)
+// and read by shade() in every raster mode: the frame's lights (ShadingContext), a surface's
+// material (SurfaceShading, one per instance and material) and each set-up triangle's
+// world-space vertices and normals (ShadingRecord). Unlit triangles have none of these.
+// The formulas are in docs/shading.md; all arithmetic is double, IEEE, no contraction.
+#pragma once
+
+#include "core/triangle_setup.hpp"
+
+#include <glm/glm.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace covrast::detail {
+
+/// covrast::ShadingModel, mirrored here (core does not include the scene API).
+enum class LitModel : std::uint8_t { Unlit, Lambert, BlinnPhong, Pbr };
+
+/// A punctual light prepared for evaluation, world space.
+struct PunctualLight {
+  enum class Kind : std::uint8_t { Directional, Point, Spot };
+  Kind kind = Kind::Directional;
+  glm::dvec3 to_light{0.0, 0.0, 1.0};    ///< directional: unit vector towards the light
+  glm::dvec3 position{0.0};              ///< point, spot [world units]
+  glm::dvec3 spot_axis{0.0, 0.0, -1.0};  ///< spot: unit direction the light travels
+  glm::dvec3 radiance{1.0};  ///< color x intensity (lux for directional, candela otherwise)
+  double inv_range = 0.0;    ///< 1 / range [1 / world units]; 0 = no range window
+  /// Spot cone (KHR_lights_punctual): attenuation = clamp(cos * scale + offset, 0, 1)^2,
+  /// scale = 1 / max(0.001, cos(inner) - cos(outer)), offset = -cos(outer) * scale.
+  double cone_scale = 0.0;
+  double cone_offset = 1.0;
+};
+
+/// The frame's lights and eye: one per front end, shared by every lit triangle.
+struct ShadingContext {
+  glm::dvec3 eye_world{0.0};
+  glm::dvec3 ambient{0.0};  ///< sum of the ambient lights' color x intensity
+  std::vector<PunctualLight> lights;
+};
+
+/// One material of one mesh instance, resolved (scene overrides applied).
+struct SurfaceShading {
+  LitModel model = LitModel::Lambert;
+  double metallic = 1.0;
+  double roughness = 1.0;    ///< perceptual; the BRDF's alpha = roughness^2
+  glm::dvec3 emissive{0.0};  ///< linear radiance, added
+  glm::dvec3 specular{0.5};  ///< blinn-phong
+  double shininess = 32.0;   ///< blinn-phong exponent
+  bool double_sided = true;  ///< back faces get the flipped normal (front end)
+  const ShadingContext* context = nullptr;
+};
+
+/// Per set-up triangle, in the TriangleSetup's vertex order. Normals are unit length and
+/// already face the viewer's side for back faces of double-sided materials.
+struct ShadingRecord {
+  glm::vec3 position_world[3];
+  glm::vec3 normal_world[3];
+  const SurfaceShading* surface;
+};
+
+/// Outgoing linear radiance at world point `p` with unit normal `n` (zero: no normal) and
+/// base colour `base` (linear): the material's model, summed over the context's lights.
+glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base, const glm::dvec3& p,
+                       const glm::dvec3& n);
+
+/// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-
+/// Reitz D, Smith height-correlated V, Schlick F, Lambert diffuse (1 - F) c_diff / pi), for
+/// unit n, v, l; without the n . l cosine. Exposed for the tests.
+glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
+                    const glm::dvec3& v, const glm::dvec3& l);
+
+}  // namespace covrast::detail
