@@ -51,11 +51,19 @@ class CoverageRasterizer final : public TileRasterizer {
     } else {
       abuffer_.begin_tile(rect);
     }
+    previous_ = nullptr;
   }
 
   void draw(const TriangleSetup& t) override {
     const PixelRect r = intersect(touched_pixels(t), rect_);
     if (r.empty()) return;
+    if (!blend_) {
+      // A copy of the triangle drawn just before (same vertices and depth plane) is level
+      // with it everywhere and later, so it shows nowhere: duplicate faces of CAD exports
+      // and stacked copies cost one comparison each.
+      if (previous_ != nullptr && same_geometry(*previous_, t)) return;
+      previous_ = &t;
+    }
     bool skip_decided = false;
     if (!blend_ && fast_paths_) {
       if (abuffer_.add_covering_tile(t, r)) return;
@@ -141,8 +149,14 @@ class CoverageRasterizer final : public TileRasterizer {
     }
   }
 
+  static bool same_geometry(const TriangleSetup& a, const TriangleSetup& b) {
+    return std::equal(a.x_fx8, a.x_fx8 + 3, b.x_fx8) && std::equal(a.y_fx8, a.y_fx8 + 3, b.y_fx8) &&
+           a.z0 == b.z0 && a.dzdx == b.dzdx && a.dzdy == b.dzdy;
+  }
+
   int tile_px_;
   bool blend_;
+  const TriangleSetup* previous_ = nullptr;  ///< the tile's last drawn triangle (not blend)
   std::size_t plane_stride_;
   PixelRect rect_;
   std::vector<std::uint16_t> plane_;  ///< the alpha plane: 8.8 coverage per pixel of the span
