@@ -448,11 +448,12 @@ TEST_CASE("coverage mode: a tessellated square shows no seam", "[coverage]") {
 
 // ---- 4. Resolve ---------------------------------------------------------------------------
 
-/// Tolerance against the 64 x 64-sample reference where the resolve uses its 16 x 16 sub-pixel
-/// masks, in linear light per channel. A straight edge through the 16 mask columns can
-/// misplace up to 1/16 of a pixel; fragments in these scenes stay within 1/32 (measured up
-/// to about 0.018). In 8-bit sRGB the same error reads large in dark channels (0.02 linear is
-/// 39 codes at 0), so the 8-bit measure is reported, and bounded only on average.
+/// Tolerance against the 64 x 64-sample reference where the resolve uses its 256-sample
+/// sub-pixel masks, in linear light per channel. A straight edge can misplace up to 1/16 of
+/// a pixel of samples (the bound of the 16x16 grid these masks had first); fragments in these
+/// scenes stay within 1/32 (measured up to about 0.018). In 8-bit sRGB the same error reads large
+/// in dark channels (0.02 linear is 39 codes at 0), so the 8-bit measure is reported, and bounded
+/// only on average.
 constexpr double kMaskToleranceLinear = 1.0 / 32.0;
 /// The same for pixels that overflowed into 256 depth-tested samples (abuffer.hpp).
 constexpr double kSampledToleranceLinear = 1.0 / 16.0;
@@ -622,15 +623,18 @@ TEST_CASE("coverage mode: more fragments than a pixel list holds keep their plac
                    << result.stats.fragment_overflows);
     CHECK(result.stats.fragment_overflows > 0);
     // A pixel whose list overflows while its fragments are not one disjoint set resolves
-    // from its 16 x 16 samples, where a straight edge can misplace up to 1/16 of a pixel.
+    // from its 256 samples, where a straight edge can misplace up to 1/16 of a pixel.
     CHECK(c.max_diff_linear <= kSampledToleranceLinear);
   }
 }
 
 // Pixel (20, 20): red A covers x < 20.3 (nearest), green B x > 20.7, blue C y < 20.9
 // (farthest), over a black background. Exact linear colour: (0.3, 0.3, 0.36). With room for
-// two fragments, the third turns the pixel into 16 x 16 samples, whose counts alone give
-// (0.3125, 0.3125, 0.328): five of sixteen columns for A and B, 84 of 256 samples for C.
+// two fragments, the third turns the pixel into 256 samples. On the 16x16 grid the masks had
+// when this was written, their counts alone gave (0.3125, 0.3125, 0.328) and failed these
+// bounds; the lattice masks (one sample per 1/256 column and row) count these axis-aligned
+// areas to within 0.004, so the case now bounds the sampled resolve more than it tells the
+// two rules apart (measured (0.3005, 0.3005, 0.3613)).
 TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of its winners",
           "[coverage]") {
   const FragmentCapacity capacity(2);
@@ -650,7 +654,7 @@ TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of i
   INFO("pixel (20, 20) linear (" << got.r << ", " << got.g << ", " << got.b
                                  << "), exact (0.3, 0.3, 0.36)");
   // A and B won every sample they own: their exact areas, scaled with C's estimate to fill
-  // what the background's 12 samples leave (0.305 each); C's share stays an estimate.
+  // what the background's samples leave; C's share stays an estimate.
   CHECK(std::fabs(got.r - 0.3) < 0.008);
   CHECK(std::fabs(got.g - 0.3) < 0.008);
   CHECK(std::fabs(got.b - 0.36) < 0.025);

@@ -73,6 +73,29 @@ Light directional(glm::dvec3 direction, double intensity) {
   return l;
 }
 
+Light point_light(glm::dvec3 position, double intensity, double range) {
+  Light l;
+  l.type = LightType::Point;
+  l.position = position;
+  l.intensity = intensity;
+  l.range = range;
+  return l;
+}
+
+/// A spot light at `position` shining along `direction` (normalised here), cone angles in
+/// degrees.
+Light spot_light(glm::dvec3 position, glm::dvec3 direction, double inner_deg, double outer_deg,
+                 double intensity) {
+  Light l;
+  l.type = LightType::Spot;
+  l.position = position;
+  l.direction = glm::normalize(direction);
+  l.inner_cone_deg = inner_deg;
+  l.outer_cone_deg = outer_deg;
+  l.intensity = intensity;
+  return l;
+}
+
 Light ambient(double intensity) {
   Light l;
   l.type = LightType::Ambient;
@@ -319,19 +342,8 @@ TEST_CASE("point and spot lights: inverse square, range window and cone on a pla
   covrast::test::add_instance(scene, plane, base);
   scene.meshes[0].materials = {lambert()};
   scene.lit = true;
-  Light point;
-  point.type = LightType::Point;
-  point.position = {-0.3, 0.2, 0.8};
-  point.intensity = 0.6;
-  point.range = 1.6;
-  Light spot;
-  spot.type = LightType::Spot;
-  spot.position = {0.4, -0.3, 1.0};
-  spot.direction = glm::normalize(glm::dvec3(0.1, 0.2, -1.0));
-  spot.inner_cone_deg = 12.0;
-  spot.outer_cone_deg = 25.0;
-  spot.intensity = 0.5;
-  scene.lights = {point, spot};
+  scene.lights = {point_light({-0.3, 0.2, 0.8}, 0.6, 1.6),
+                  spot_light({0.4, -0.3, 1.0}, {0.1, 0.2, -1.0}, 12.0, 25.0, 0.5)};
   // KHR_lights_punctual: E = I / d^2 x clamp(1 - (d / range)^4, 0, 1) x cone^2.
   const auto expected = [&](const glm::dvec3& p) {
     double e = 0.0;
@@ -396,20 +408,10 @@ Scene lit_test_scene() {
   covrast::test::add_instance(scene, quad, glm::vec3(0.9f));
   scene.meshes[2].materials = {lambert()};
   scene.lit = true;
-  Light point;
-  point.type = LightType::Point;
-  point.position = {-1.0, 1.5, 2.0};
-  point.intensity = 4.0;
-  point.range = 6.0;
-  Light spot;
-  spot.type = LightType::Spot;
-  spot.position = {1.5, 2.0, 1.0};
-  spot.direction = glm::normalize(glm::dvec3(-1.0, -2.0, -1.0));
-  spot.inner_cone_deg = 10.0;
-  spot.outer_cone_deg = 30.0;
-  spot.intensity = 8.0;
+  Light spot = spot_light({1.5, 2.0, 1.0}, {-1.0, -2.0, -1.0}, 10.0, 30.0, 8.0);
   spot.color_linear = {0.4f, 0.6f, 1.0f};
-  scene.lights = {directional({0.3, -1.0, -0.5}, 2.0), point, spot, ambient(0.05)};
+  scene.lights = {directional({0.3, -1.0, -0.5}, 2.0), point_light({-1.0, 1.5, 2.0}, 4.0, 6.0),
+                  spot, ambient(0.05)};
   return scene;
 }
 

@@ -200,10 +200,6 @@ double polygon_area(const ClipPolygon& poly) {
   return 0.5 * std::fabs(twice);
 }
 
-/// The share of triangle `t`'s part of pixel (x, y) where its plane is nearer than the
-/// opaque plane `o`: the pixel square clipped by t's three edges, then by the line where the
-/// planes meet (both affine, so the line is straight), by exact polygon clipping in double.
-/// Negative when t's part is too thin to measure.
 /// The part of pixel (x, y) inside triangle `t`: the pixel square clipped by its three edges.
 ClipPolygon part_in_pixel(const TriangleSetup& t, int x, int y) {
   ClipPolygon poly;
@@ -239,6 +235,10 @@ bool inner_point(const ClipPolygon& poly, double& px, double& py) {
   return true;
 }
 
+/// The share of triangle `t`'s part of pixel (x, y) where its plane is nearer than the
+/// opaque plane `o`: the pixel square clipped by t's three edges, then by the line where the
+/// planes meet (both affine, so the line is straight), by exact polygon clipping in double.
+/// Negative when t's part is too thin to measure.
 double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int y) {
   ClipPolygon poly = part_in_pixel(t, x, y);
   const double inside = polygon_area(poly);
@@ -712,7 +712,6 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
 
 namespace {
 
-/// Offsets of the sample rows and columns from sample (0, 0) [pixels]: k / 16, exact.
 /// Sample offsets from the pixel's corner [pixels], exact in double.
 constexpr auto kSampleOffsetX = [] {
   std::array<double, kMaskSamples> offset{};
@@ -802,9 +801,9 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
                                 bool* estimated) const {
   double best_z[kMaskSamples];
   std::uint32_t best_primitive[kMaskSamples];
-  // Per sample, the fragment nearest so far plus one (0: none); won[k + 1] counts the
-  // samples fragment k holds, kept as samples change hands (won[0] only takes the
-  // decrements of samples that no fragment held before).
+  // Per sample, the fragment nearest so far plus one (0: none); once every fragment is
+  // tested, won[k + 1] counts the samples fragment k holds and won[0] those the opaque
+  // surface or the background keeps.
   std::uint8_t best[kMaskSamples];
   int won[kMaxFragmentsPerPixel + 1] = {};
   static_assert(kMaxFragmentsPerPixel < 256);

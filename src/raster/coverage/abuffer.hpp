@@ -24,7 +24,7 @@
 //    leave the list. This is what keeps lists short on dense and open meshes, where no
 //    single triangle covers a pixel; the farthest depth of the set bounds it cheaply first;
 //  - otherwise the pixel resolves from its list (resolve_pixel): a set of pairwise disjoint
-//    fragments in front of the opaque surface adds its areas; else 16x16 sub-pixel samples
+//    fragments in front of the opaque surface adds its areas; else 256 sub-pixel samples
 //    with per-sample depth from each plane decide what hides what: a fragment that nothing
 //    in front of it overlaps keeps its exact area, the others get their coverage times the
 //    share of their samples where they are nearest; what remains goes to the opaque surface
@@ -143,7 +143,7 @@ class ABufferTile {
   /// What a fragment that stands for several triangles of one surface keeps (overflow only).
   static constexpr int kMaxMergedPieces = 6;
   struct MergedPiece {
-    SampleMask mask;       ///< 16x16 sample mask: the union of the pieces'
+    SampleMask mask;       ///< 256-sample mask: the union of the pieces'
     glm::vec3 color;       ///< coverage-weighted mean colour (linear)
     std::uint32_t weight;  ///< summed coverage behind `color` (unclamped)
     /// The triangles it stands for, so that overlap tests stay exact.
@@ -203,7 +203,7 @@ class ABufferTile {
   /// Removes the fragments for which `drop(fragment)` holds from the pixel's list.
   template <class Drop>
   void remove_fragments(std::size_t pixel, Drop drop);
-  /// Turns a pixel's list into 16x16 sub-pixel samples (see PixelSamples) and frees it.
+  /// Turns a pixel's list into 256 sub-pixel samples (see PixelSamples) and frees it.
   void to_samples(std::size_t pixel, int x, int y);
   /// Draws triangle `t` into a sampled pixel's samples: nearest wins, equal depth keeps the
   /// earlier triangle.
@@ -220,7 +220,7 @@ class ABufferTile {
                            std::uint32_t coverage, double centre_z);
   /// The merged data of fragment `f` (which has kMergedFlag).
   const MergedPiece& merged_piece(std::uint32_t f) const { return merged_[merged_slot_[f]]; }
-  /// Each fragment's visible weight from the 16x16 samples (estimated[i]: a share of its
+  /// Each fragment's visible weight from the 256 samples (estimated[i]: a share of its
   /// samples, not an exact area); returns how many samples the opaque surface or the
   /// background behind keeps.
   int sample_weights(int x, int y, const TriangleSetup* opaque, int n,
