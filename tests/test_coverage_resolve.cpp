@@ -1,5 +1,5 @@
 // Tests of the coverage mode through the whole renderer (covrast::render): tessellations
-// without seams, the A-buffer resolve (src/resolve/abuffer.cpp) against a brute-force
+// without seams, the A-buffer resolve (src/raster/coverage/abuffer_resolve.cpp) against a brute-force
 // reference computed here (64 x 64 samples per pixel, point-in-triangle with the top-left
 // rule on the snapped vertices, per-sample depth, linear-light average, sRGB encode), and
 // byte-identical images for every thread count, tile size and SIMD target.

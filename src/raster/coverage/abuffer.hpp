@@ -1,5 +1,9 @@
-// Resolve stage, coverage mode: a per-tile A-buffer (Carpenter 1984) whose weights are the
-// exact analytic areas of the coverage kernel.
+// Raster stage, coverage mode: the mode's tile state, a per-tile A-buffer (Carpenter 1984)
+// whose weights are the exact analytic areas of the coverage kernel. Its parts: this header
+// (the per-pixel insertion, ABufferTile::add), abuffer.cpp (tile and block fast paths),
+// abuffer_insert.cpp (open and closed sets, merging), abuffer_samples.cpp (overflow into
+// samples), abuffer_resolve.cpp and abuffer_visibility.cpp (the resolve), abuffer_planes.hpp
+// (depth planes and pixel polygons they share).
 //
 // Fully covered pixels take a fast path: an ordinary depth test against one opaque
 // surface per pixel (depth planes compared at the pixel's four corners, so a plane that
@@ -276,7 +280,7 @@ class ABufferTile {
   static std::uint32_t convex_key(const TriangleSetup& t) {
     return t.convex_surface ? t.surface * 2 + (t.front_facing ? 1u : 0u) : kNoConvexKey;
   }
-  /// Colour of a layer in front of everything else (abuffer.cpp).
+  /// Colour of a layer in front of everything else (abuffer_resolve.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
   std::vector<Layer> layer_;
   std::vector<LayerSums> layer_sums_;

@@ -1,5 +1,5 @@
 // Coverage mode: the 256-sample sub-pixel mask of a triangle in one pixel, used by the
-// A-buffer (abuffer.cpp) where surfaces meet.
+// A-buffer (abuffer_visibility.cpp, abuffer_samples.cpp) where surfaces meet.
 //
 // The samples form a rank-1 lattice (Korobov): sample k, k in [0, 256), lies at
 //

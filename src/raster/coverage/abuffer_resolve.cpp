@@ -1,0 +1,362 @@
+// Raster stage, coverage mode: the A-buffer's resolve (abuffer.hpp): uniform blocks, the
+// one-layer sums, and the list resolve of resolve_pixel; the sample-based weights it falls
+// back on are in abuffer_visibility.cpp.
+#include "raster/coverage/abuffer.hpp"
+
+#include "core/shading.hpp"
+#include "core/srgb8.hpp"
+#include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/triangle_overlap.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstddef>
+#include <limits>
+
+namespace covrast::detail {
+namespace {
+
+std::atomic<bool> g_list_resolve{false};
+std::atomic<bool> g_mask_resolve{false};
+std::atomic<std::uint64_t> g_layer_resolves{0};
+
+bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
+  return a.surface == b.surface && a.front_facing == b.front_facing;
+}
+
+/// Pixel (x, y) showing `opaque` (null: the background) alone: its colour, and its window
+/// depth in `depth`.
+glm::vec3 opaque_pixel(const TriangleSetup* opaque, int x, int y, glm::vec3 background,
+                       float& depth) {
+  const double cx = x + 0.5, cy = y + 0.5;
+  depth =
+      opaque != nullptr ? float(opaque->depth_at(cx, cy)) : std::numeric_limits<float>::infinity();
+  return opaque != nullptr ? shade(*opaque, cx, cy, true) : background;
+}
+
+/// Whether two fragments are pieces of one layer of a surface: same mesh instance and facing,
+/// and sharing a vertex; a merged fragment stands for several adjacent pieces (merges keep to
+/// the open set, see merge_into_open_set), so it joins any fragment of its surface that overlaps it
+/// in depth.
+bool layer_neighbours(const TriangleSetup& a, bool a_merged, DepthRange ra, const TriangleSetup& b,
+                      bool b_merged, DepthRange rb) {
+  if (!same_surface(a, b)) return false;
+  if (share_vertex(a, b)) return true;
+  return (a_merged || b_merged) && !(ra.max < rb.min || rb.max < ra.min);
+}
+
+/// The front layer of a pixel's fragments: the one nearest at its nearest point (among the
+/// `active` ones; null: all) and every fragment connected to it through `connected`,
+/// transitively. Marks them in `in_layer` and returns their count, summed coverage and the
+/// farthest depth they reach (members 0 when no fragment is active).
+struct FrontLayer {
+  int members;
+  std::uint32_t coverage;
+  double max_depth;
+};
+template <class Connected>
+FrontLayer find_front_layer(int n, const DepthRange* range, const std::uint32_t* coverage,
+                            const bool* active, Connected connected, bool* in_layer) {
+  int nearest = -1;
+  for (int i = 0; i < n; ++i) {
+    in_layer[i] = false;
+    if ((active == nullptr || active[i]) && (nearest < 0 || range[i].min < range[nearest].min)) {
+      nearest = i;
+    }
+  }
+  if (nearest < 0) return FrontLayer{0, 0, 0.0};
+  int stack[kMaxFragmentsPerPixel], top = 0;
+  in_layer[nearest] = true;
+  stack[top++] = nearest;
+  FrontLayer layer{1, coverage[nearest], range[nearest].max};
+  while (top > 0) {
+    const int m = stack[--top];
+    for (int j = 0; j < n; ++j) {
+      if (in_layer[j] || (active != nullptr && !active[j]) || !connected(m, j)) continue;
+      in_layer[j] = true;
+      stack[top++] = j;
+      ++layer.members;
+      layer.coverage += coverage[j];
+      layer.max_depth = std::max(layer.max_depth, range[j].max);
+    }
+  }
+  return layer;
+}
+
+/// The triangles each fragment of a pixel stands for: itself, or a merged fragment's pieces.
+struct FragmentPieces {
+  const TriangleSetup* const* piece;
+  int count;
+};
+
+/// Whether two fragments' triangles have pairwise disjoint interiors (triangle_overlap.hpp).
+bool fragments_disjoint(FragmentPieces a, FragmentPieces b) {
+  for (int i = 0; i < a.count; ++i) {
+    for (int j = 0; j < b.count; ++j) {
+      if (!interiors_disjoint(*a.piece[i], *b.piece[j])) return false;
+    }
+  }
+  return true;
+}
+
+/// Whether the fragments i with `member[i]` (all when null) provably do not overlap, so
+/// that their exact areas add.
+bool pieces_disjoint(int n, const FragmentPieces* pieces, const bool* member) {
+  for (int i = 0; i < n; ++i) {
+    if (member != nullptr && !member[i]) continue;
+    for (int j = i + 1; j < n; ++j) {
+      if (member != nullptr && !member[j]) continue;
+      if (!fragments_disjoint(pieces[i], pieces[j])) return false;
+    }
+  }
+  return true;
+}
+
+/// The share of triangle `t`'s part of pixel (x, y) where its plane is nearer than the
+/// opaque plane `o`: the pixel square clipped by t's three edges, then by the line where the
+/// planes meet (both affine, so the line is straight), by exact polygon clipping in double.
+/// Negative when t's part is too thin to measure.
+double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int y) {
+  ClipPolygon poly = part_in_pixel(t, x, y);
+  const double inside = polygon_area(poly);
+  if (!(inside > 1e-12)) return -1.0;
+  // Nearer where d = z_o - z_t > 0; d is affine: d(p) = d0 + ddx x + ddy y.
+  const double d0 = o.depth_at(0.0, 0.0) - t.depth_at(0.0, 0.0);
+  clip_half_plane(poly, d0, o.dzdx - t.dzdx, o.dzdy - t.dzdy);
+  return std::clamp(polygon_area(poly) / inside, 0.0, 1.0);
+}
+
+/// Sample shares (won / owned) are quantised: a sliver of the next layer that shows along an
+/// edge of the front one is mostly missed by the samples, and what they miss would go to the
+/// opaque surface or the background behind, which may be hidden there. So the weights that
+/// are estimates (`estimated`) are scaled together to fill what the exact ones leave, less
+/// the share of the samples that the surface behind won; each stays within its own coverage.
+void fill_estimated_share(int n, const std::uint32_t* cov, const bool* estimated,
+                          double behind_share, double* weight) {
+  double exact = 0.0, estimate = 0.0;
+  for (int i = 0; i < n; ++i) (estimated[i] ? estimate : exact) += weight[i];
+  if (!(estimate > 0.0)) return;
+  const double scale = std::max(0.0, 1.0 - exact - behind_share) / estimate;
+  for (int i = 0; i < n; ++i) {
+    if (estimated[i]) weight[i] = std::min(weight[i] * scale, double(cov[i]) / kCoverageOne);
+  }
+}
+
+}  // namespace
+
+void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
+void force_abuffer_mask_resolve(bool on) {
+  g_mask_resolve.store(on);
+  g_list_resolve.store(on);
+}
+std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
+
+/// A layer in front of everything else: colour = (sum coverage_i colour_i) / max(sum
+/// coverage_i, 1) + (1 - min(sum coverage_i, 1)) * behind, in 8.8 units; a sum above one
+/// pixel (rounding, or merged pieces) is normalised.
+glm::vec3 ABufferTile::front_layer_color(const LayerSums& sums, glm::vec3 behind) {
+  const std::uint32_t full = kCoverageOne;
+  const double denominator = double(std::max(sums.coverage, full));
+  const double rest = double(full - std::min(sums.coverage, full)) / kCoverageOne;
+  return glm::vec3(float(sums.rgb[0] / denominator + rest * behind.r),
+                   float(sums.rgb[1] / denominator + rest * behind.g),
+                   float(sums.rgb[2] / denominator + rest * behind.b));
+}
+
+glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
+                                     float& depth) {
+  const double cx = x + 0.5, cy = y + 0.5;
+  const TriangleSetup* opaque = opaque_[pixel];
+  const glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
+  if (head_[pixel] == kEnd) return behind;
+
+  const DepthRange opaque_range =
+      opaque != nullptr ? depth_range(*opaque, x, y) : DepthRange{kFar, kFar};
+  const TriangleSetup* tri[kMaxFragmentsPerPixel];
+  std::uint32_t cov[kMaxFragmentsPerPixel];
+  DepthRange range[kMaxFragmentsPerPixel];
+  const MergedPiece* merged[kMaxFragmentsPerPixel];  // null unless it stands for several
+  FragmentPieces pieces[kMaxFragmentsPerPixel];
+  int n = 0;
+  bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    const TriangleSetup* t = pool_[f].triangle;
+    const double centre_z = t->depth_at(cx, cy);
+    pieces[n].count = fragment_pieces(f, pieces[n].piece);
+    // A merged fragment spans its pieces' planes: its range is their union, and it is
+    // behind the opaque surface only where every piece is.
+    DepthRange r{kFar, -kFar};
+    bool behind_opaque = opaque != nullptr, crosses_opaque = false;
+    for (int k = 0; k < pieces[n].count; ++k) {
+      const TriangleSetup& p = *pieces[n].piece[k];
+      const DepthRange pr =
+          &p == t ? range_around(p, centre_z) : range_around(p, p.depth_at(cx, cy));
+      r = {std::min(r.min, pr.min), std::max(r.max, pr.max)};
+      if (opaque == nullptr) continue;
+      const DepthOrder order = pr.max < opaque_range.min    ? DepthOrder::InFront
+                               : pr.min >= opaque_range.max ? DepthOrder::Behind
+                                                            : order_of(p, *opaque, x, y);
+      behind_opaque = behind_opaque && order == DepthOrder::Behind;
+      crosses_opaque = crosses_opaque || order == DepthOrder::Crossing;
+    }
+    if (behind_opaque) continue;  // hidden: the opaque surface came later
+    crossing = crossing || crosses_opaque;
+    tri[n] = t;
+    const std::uint32_t c = pool_[f].coverage;
+    cov[n] = c & kCoverageBits;
+    merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
+    range[n] = r;
+    depth = std::min(depth, float(centre_z));
+    ++n;
+  }
+  if (n == 0) return behind;
+
+  const bool sums_allowed = !g_mask_resolve.load(std::memory_order_relaxed);
+  // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
+  // the open set's sums give; resolve() takes those directly where it can).
+  auto layer_color = [&](const bool* member) {
+    LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
+    for (int i = 0; i < n; ++i) {
+      if (member != nullptr && !member[i]) continue;
+      const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+      sums.coverage += cov[i];
+      sums.rgb[0] += double(cov[i]) * c.r;
+      sums.rgb[1] += double(cov[i]) * c.g;
+      sums.rgb[2] += double(cov[i]) * c.b;
+    }
+    return front_layer_color(sums, behind);
+  };
+  if (sums_allowed && !crossing && pieces_disjoint(n, pieces, nullptr)) {
+    return layer_color(nullptr);
+  }
+
+  // The front layer: the fragment nearest at its nearest point and every fragment
+  // connected to it (same mesh instance and facing, through shared vertices; a merged
+  // fragment already stands for adjacent pieces of its surface). When its pieces provably
+  // do not overlap and it lies wholly in front of everything else, its exact areas add, and
+  // when they fill the pixel nothing behind shows.
+  auto connected = [&](int i, int j) {
+    return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
+                            range[j]);
+  };
+  bool in_front[kMaxFragmentsPerPixel];
+  const FrontLayer front = find_front_layer(n, range, cov, nullptr, connected, in_front);
+  bool front_separate = !crossing;
+  for (int j = 0; j < n && front_separate; ++j) {
+    if (!in_front[j] && !(front.max_depth < range[j].min)) front_separate = false;
+  }
+  if (sums_allowed && front_separate &&
+      (front.members == n || front.coverage >= std::uint32_t(kCoverageOne)) &&
+      pieces_disjoint(n, pieces, in_front)) {
+    return layer_color(in_front);
+  }
+  double weight[kMaxFragmentsPerPixel];
+  // One triangle crossing the opaque plane inside the pixel (where two surfaces
+  // interpenetrate): its visible part is exact by polygon clipping, no masks needed.
+  const double share =
+      n == 1 && crossing && merged[0] == nullptr ? visible_share(*tri[0], *opaque, x, y) : -1.0;
+  if (share >= 0.0) {
+    weight[0] = double(cov[0]) / kCoverageOne * share;
+  } else {
+    bool estimated[kMaxFragmentsPerPixel];
+    const int behind_samples = sample_weights(x, y, opaque, n, tri, cov, merged, weight, estimated);
+    fill_estimated_share(n, cov, estimated, double(behind_samples) / kMaskSamples, weight);
+  }
+  double total = 0;
+  for (int i = 0; i < n; ++i) total += weight[i];
+  const double scale = total > 1.0 ? 1.0 / total : 1.0;
+  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
+  double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
+  for (int i = 0; i < n; ++i) {
+    if (weight[i] == 0) continue;
+    const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+    double w = weight[i] * scale;
+    r += w * c.r;
+    g += w * c.g;
+    b += w * c.b;
+  }
+  return glm::vec3(float(r), float(g), float(b));
+}
+
+void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
+                                       const FrameTarget& target) {
+  if (opaque == nullptr || opaque->flat_color) {
+    // One colour: encode it once and fill; depth as write_tile stores it (at most 1, the
+    // background 1).
+    const glm::vec3 c = opaque != nullptr ? opaque->color[0] : target.background_linear;
+    const std::uint8_t code[3] = {encode_srgb8(c.r), encode_srgb8(c.g), encode_srgb8(c.b)};
+    for (int y = r.y0; y < r.y1; ++y) {
+      std::uint8_t* dst = target.color->pixel(r.x0, y);
+      for (int x = r.x0; x < r.x1; ++x, dst += 3) {
+        dst[0] = code[0];
+        dst[1] = code[1];
+        dst[2] = code[2];
+      }
+      if (target.depth == nullptr) continue;
+      float* depth = &target.depth->depth[std::size_t(y) * target.depth->width + r.x0];
+      for (int x = r.x0; x < r.x1; ++x) {
+        *depth++ = opaque != nullptr ? clamp_window_depth(float(opaque->depth_at(x + 0.5, y + 0.5)))
+                                     : 1.0f;
+      }
+    }
+    return;
+  }
+  for (int y = r.y0; y < r.y1; ++y) {
+    const std::size_t row = std::size_t(y - rect_.y0) * stride_;
+    for (int x = r.x0; x < r.x1; ++x) {
+      color_[row + (x - rect_.x0)] =
+          opaque_pixel(opaque, x, y, target.background_linear, depth_[row + (x - rect_.x0)]);
+    }
+  }
+  const std::size_t first = std::size_t(r.y0 - rect_.y0) * stride_ + (r.x0 - rect_.x0);
+  write_tile(target, r, color_.data() + first, depth_.data() + first, stride_);
+}
+
+void ABufferTile::resolve(const FrameTarget& target) {
+  if (tile_uniform_) {
+    resolve_opaque_block(uniform_, rect_, target);
+    return;
+  }
+  const bool use_sums = !g_list_resolve.load(std::memory_order_relaxed);
+  std::uint64_t from_sums = 0;
+  const int block_cols = (rect_.x1 - rect_.x0 + kBlockPx - 1) / kBlockPx;
+  const int block_rows = (rect_.y1 - rect_.y0 + kBlockPx - 1) / kBlockPx;
+  for (int by = 0; by < block_rows; ++by) {
+    for (int bx = 0; bx < block_cols; ++bx) {
+      const std::size_t block = std::size_t(by) * block_stride_ + bx;
+      const PixelRect br = block_rect(block);
+      if (block_uniform_[block]) {
+        resolve_opaque_block(block_opaque_[block], br, target);
+        continue;
+      }
+      for (int y = br.y0; y < br.y1; ++y) {
+        for (int x = br.x0; x < br.x1; ++x) {
+          const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+          if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
+            // One layer over the background: what resolve_pixel's first branch gives.
+            const LayerSums& sums = layer_sums_[pixel];
+            color_[pixel] = front_layer_color(sums, target.background_linear);
+            depth_[pixel] = sums.depth;
+            ++from_sums;
+            continue;
+          }
+          if (layer_[pixel] == Layer::Sampled) {
+            color_[pixel] = resolve_samples(pixel, x, y, target.background_linear, depth_[pixel]);
+            continue;
+          }
+          if (head_[pixel] == kEnd) {
+            // No fragments: the opaque surface or the background, as resolve_pixel gives it.
+            color_[pixel] =
+                opaque_pixel(opaque_[pixel], x, y, target.background_linear, depth_[pixel]);
+            continue;
+          }
+          color_[pixel] = resolve_pixel(pixel, x, y, target.background_linear, depth_[pixel]);
+        }
+      }
+      const std::size_t first = std::size_t(br.y0 - rect_.y0) * stride_ + (br.x0 - rect_.x0);
+      write_tile(target, br, color_.data() + first, depth_.data() + first, stride_);
+    }
+  }
+  g_layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
+}
+}  // namespace covrast::detail

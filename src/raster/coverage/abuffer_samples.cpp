@@ -1,0 +1,126 @@
+// Raster stage, coverage mode: pixels whose fragment list overflowed, kept as depth-tested
+// samples at the sample masks' positions (ABufferTile::PixelSamples), and their resolve.
+#include "raster/coverage/abuffer.hpp"
+
+#include "core/shading.hpp"
+#include "raster/coverage/abuffer_planes.hpp"
+
+#include <algorithm>
+#include <limits>
+
+namespace covrast::detail {
+
+bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                    std::uint32_t coverage, double centre_z) {
+  ++overflows_;
+  if (layer_[pixel] == Layer::Sampled) {
+    add_to_samples(pixel, x, y, *t);
+    return true;
+  }
+  if (open_count_[pixel] != 0 && joins_open_set(pixel, *t) &&
+      merge_into_open_set(pixel, x, y, *t, coverage, centre_z)) {
+    return true;
+  }
+  to_samples(pixel, x, y);
+  add_to_samples(pixel, x, y, *t);
+  return true;
+}
+
+void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
+  const std::uint32_t slot = std::uint32_t(samples_.size());
+  samples_.emplace_back();
+  PixelSamples& samples = samples_.back();
+  const TriangleSetup* opaque = opaque_[pixel];
+  if (opaque != nullptr) {
+    const SamplePlane plane(*opaque, x, y);
+    for (int s = 0; s < kMaskSamples; ++s) samples.z[s] = plane.at(s);
+  } else {
+    std::fill(samples.z, samples.z + kMaskSamples, kFar);
+  }
+  std::fill(samples.winner, samples.winner + kMaskSamples, opaque);
+  // The stored fragments, in list order (merged ones by their pieces, which they always know:
+  // merges happen only inside the open set), then the list is gone.
+  const std::uint32_t head = head_[pixel];
+  layer_[pixel] = Layer::Sampled;
+  tail_[pixel] = slot;
+  count_[pixel] = std::uint8_t(kMaxFragmentsPerPixel);  // every later fragment comes here
+  for (std::uint32_t f = head; f != kEnd; f = pool_[f].next) {
+    if (!(pool_[f].coverage & kMergedFlag)) {
+      add_to_samples(pixel, x, y, *pool_[f].triangle);
+      continue;
+    }
+    const MergedPiece& m = merged_piece(f);  // an open-set member: its pieces, one by one
+    for (int k = 0; k < m.pieces; ++k) add_to_samples(pixel, x, y, *m.piece[k]);
+  }
+  head_[pixel] = kEnd;
+  open_count_[pixel] = closed_count_[pixel] = 0;
+}
+
+void ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t) {
+  PixelSamples& samples = samples_[tail_[pixel]];
+  const SampleMask mask = pixel_sample_mask(t, x, y);
+  const SamplePlane plane(t, x, y);
+  for_each_sample(mask, [&](int s) {
+    const double z = plane.at(s);
+    const TriangleSetup* w = samples.winner[s];
+    // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
+    if (z < samples.z[s] || (z == samples.z[s] && w != nullptr && t.primitive < w->primitive)) {
+      samples.z[s] = z;
+      samples.winner[s] = &t;
+    }
+  });
+}
+
+glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,
+                                       float& depth) {
+  // Each triangle that won samples shows over its exact area times the share of its own
+  // samples that it won (as sample_weights weighs fragments), and the background over its
+  // share of the samples. A piece too thin to own a sample drops out, so the triangles'
+  // weights are scaled to fill what the background leaves: the pieces of a tessellation
+  // still cover the pixel, and no background leaks where none shows.
+  const PixelSamples& samples = samples_[tail_[pixel]];
+  const TriangleSetup* winner[kMaskSamples];
+  int won[kMaskSamples];
+  int winners = 0, background_won = 0;
+  const TriangleSetup* last = nullptr;
+  int last_slot = -1;
+  depth = std::numeric_limits<float>::infinity();
+  for (int s = 0; s < kMaskSamples; ++s) {
+    const TriangleSetup* w = samples.winner[s];
+    if (w == nullptr) {
+      ++background_won;
+      continue;
+    }
+    depth = std::min(depth, float(samples.z[s]));
+    if (w != last) {  // winners come in runs: look each run's up once
+      last = w;
+      last_slot = int(std::find(winner, winner + winners, w) - winner);
+      if (last_slot == winners) {
+        winner[winners] = w;
+        won[winners++] = 0;
+      }
+    }
+    ++won[last_slot];
+  }
+  double weight[kMaskSamples];
+  double total = 0.0;
+  for (int k = 0; k < winners; ++k) {
+    const int owned = pixel_sample_mask(*winner[k], x, y).count();
+    const double area = std::clamp(polygon_area(part_in_pixel(*winner[k], x, y)), 0.0, 1.0);
+    weight[k] = owned > 0 && area > 0.0 ? area * won[k] / owned : double(won[k]) / kMaskSamples;
+    total += weight[k];
+  }
+  const double background_share = double(background_won) / kMaskSamples;
+  const double scale = total > 0.0 ? (1.0 - background_share) / total : 0.0;
+  double r = background_share * background.r, g = background_share * background.g,
+         b = background_share * background.b;
+  for (int k = 0; k < winners; ++k) {
+    const glm::vec3 c = shade(*winner[k], x + 0.5, y + 0.5, true);
+    const double w = weight[k] * scale;
+    r += w * c.r;
+    g += w * c.g;
+    b += w * c.b;
+  }
+  return glm::vec3(float(r), float(g), float(b));
+}
+}  // namespace covrast::detail
