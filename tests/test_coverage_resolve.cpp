@@ -1,7 +1,7 @@
 // Tests of the coverage mode through the whole renderer (covrast::render): tessellations
-// without seams, the A-buffer resolve (src/raster/coverage/abuffer_resolve.cpp) against a brute-force
-// reference computed here (64 x 64 samples per pixel, point-in-triangle with the top-left
-// rule on the snapped vertices, per-sample depth, linear-light average, sRGB encode), and
+// without seams, the A-buffer resolve (src/raster/coverage/abuffer_resolve.cpp) against a
+// brute-force reference computed here (64 x 64 samples per pixel, point-in-triangle with the
+// top-left rule on the snapped vertices, per-sample depth, linear-light average, sRGB encode), and
 // byte-identical images for every thread count, tile size and SIMD target.
 //
 // Scenes are built in code. The camera looks down -z from (0, 0, 10); world_at() places a
@@ -642,10 +642,10 @@ int samples_inside(const std::vector<ScreenVertex>& v, int x_px, int y_px) {
   }
   int inside = 0, on_edge = 0;
   for (int k = 0; k < covrast::detail::kMaskSamples; ++k) {
-    const std::int64_t px = std::int64_t(x_px) * kMaskUnitsPerPixel +
-                            covrast::detail::kMaskSampleX_fx9[std::size_t(k)];
-    const std::int64_t py = std::int64_t(y_px) * kMaskUnitsPerPixel +
-                            covrast::detail::kMaskSampleY_fx9[std::size_t(k)];
+    const std::int64_t px =
+        std::int64_t(x_px) * kMaskUnitsPerPixel + covrast::detail::kMaskSampleX_fx9[std::size_t(k)];
+    const std::int64_t py =
+        std::int64_t(y_px) * kMaskUnitsPerPixel + covrast::detail::kMaskSampleY_fx9[std::size_t(k)];
     int positive = 0, negative = 0;
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3;
@@ -673,8 +673,8 @@ int samples_inside(const std::vector<ScreenVertex>& v, int x_px, int y_px) {
 TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of its winners",
           "[coverage]") {
   // On the 1/256 grid, so that snapping keeps it exactly.
-  const std::vector<ScreenVertex> a = {{20.44140625, 20.875, 0.9}, {20.00390625, 20.1875, 0.9},
-                                       {20.69140625, 21.0, 0.9}};
+  const std::vector<ScreenVertex> a = {
+      {20.44140625, 20.875, 0.9}, {20.00390625, 20.1875, 0.9}, {20.69140625, 21.0, 0.9}};
   const double area_a = 15.0 / 256.0;
   const double counted_a = samples_inside(a, 20, 20) / 256.0;
   INFO("A's exact area " << area_a << ", its share of the samples " << counted_a);
@@ -703,6 +703,40 @@ TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of i
   CHECK(std::fabs(got.g - 0.25) < 0.012);
   const ReferenceImage ref = reference_render(s, screen_triangles(s));
   CHECK(std::fabs(got.b - ref.linear[20 * 40 + 20].b) < 0.02);
+}
+
+// Pixel (20, 20), one mesh drawn in this order: S (red, near) the lower right quadrant, X
+// (blue, middle depth) the right half, Q (red, near) the left half, R (red, far) the upper
+// right quadrant. With room for three fragments, R arrives at a full list and merges into S
+// (they share an edge), so one fragment stands for a near and a far piece. X lies between
+// them: it hides R and S hides it, so the exact colour is red 3/4, blue 1/4. Were the merged
+// fragment depth-tested with S's plane alone, R's quadrant would show red.
+TEST_CASE("coverage mode: a merged fragment's pieces are depth-tested with their own planes",
+          "[coverage]") {
+  const FragmentCapacity capacity(3);
+  Scene s = make_scene(40, 40, glm::vec3(0));
+  const glm::vec3 red(1, 0, 0), blue(0, 0, 1);
+  const std::vector<ScreenVertex> v = {
+      {20.5, 20.5, 0.9}, {35.0, 20.5, 0.9}, {20.5, 35.0, 0.9},   // S
+      {20.5, 5.0, 0.5},  {36.0, 20.5, 0.5}, {20.5, 36.0, 0.5},   // X
+      {20.5, 10.0, 0.9}, {20.5, 31.0, 0.9}, {5.0, 20.5, 0.9},    // Q
+      {20.5, 20.5, 0.1}, {20.5, 6.0, 0.1},  {35.0, 20.5, 0.1}};  // R
+  add_instance(s,
+               screen_mesh(s, v, {red, red, red, blue, blue, blue, red, red, red, red, red, red}),
+               glm::vec3(1), ColorSource::Vertex);
+  const auto result = render(s, ModeKind::Coverage);
+  CHECK(result.stats.fragment_overflows > 0);
+  const std::uint8_t* p = result.color.pixel(20, 20);
+  const double red_linear = covrast::srgb_to_linear(p[0] / 255.0f);
+  const double blue_linear = covrast::srgb_to_linear(p[2] / 255.0f);
+  const ReferenceImage ref = reference_render(s, screen_triangles(s));
+  const glm::dvec3 r = ref.linear[20 * 40 + 20];
+  INFO("pixel (20, 20) linear red " << red_linear << ", blue " << blue_linear << "; reference "
+                                    << r.r << ", " << r.b);
+  CHECK(std::fabs(red_linear - 0.75) < 0.01);
+  CHECK(std::fabs(blue_linear - 0.25) < 0.01);
+  CHECK(std::fabs(r.r - 0.75) < 0.01);
+  CHECK(std::fabs(r.b - 0.25) < 0.01);
 }
 
 // Two triangles folded over one another along a shared edge at y = 20.98: each covers the
