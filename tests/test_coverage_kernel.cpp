@@ -493,13 +493,9 @@ TEST_CASE("coverage kernel matches the exact area of triangle and pixel", "[cove
 }
 
 TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[coverage]") {
-  const std::int64_t compiled = covrast::detail::coverage_kernel_targets();
   // Read before any forcing: SupportedTargets() reports the mock once one is set.
   const std::int64_t supported = hwy::SupportedTargets();
-  std::vector<std::int64_t> targets;
-  for (std::int64_t bits = compiled & supported; bits != 0; bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
+  const std::vector<std::int64_t> targets = covrast::test::usable_targets();
   std::string names;
   for (std::int64_t t : targets) names += std::string(hwy::TargetName(t)) + " ";
   WARN("coverage kernel targets compiled and supported here: " << names);
@@ -572,16 +568,16 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
     CHECK(m.rows == 0);
   }
   for (std::int64_t target : targets) {
-    covrast::detail::force_coverage_kernel_target(target);
+    covrast::detail::force_simd_target(target);
     INFO("target " << hwy::TargetName(target));
-    CHECK(std::string(covrast::detail::coverage_kernel_target_name()) == hwy::TargetName(target));
+    CHECK(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
     const Mismatch m = compare({Path::KernelAllRows, Path::KernelLikeDraw, Path::Fused});
     INFO(m.first);
     CHECK(m.pixels == 0);
     CHECK(m.beyond == 0);
     CHECK(m.rows == 0);
   }
-  covrast::detail::force_coverage_kernel_target(0);
+  covrast::detail::force_simd_target(0);
   CHECK(hwy::SupportedTargets() == supported);
 }
 
@@ -611,12 +607,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
     }
   };
   auto cols = std::make_unique<CoverageColumns>();
-  const std::int64_t supported = hwy::SupportedTargets();
-  std::vector<std::int64_t> targets;
-  for (std::int64_t bits = covrast::detail::coverage_kernel_targets() & supported; bits != 0;
-       bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
+  const std::vector<std::int64_t> targets = covrast::test::usable_targets();
   constexpr int kRows = 12;
   std::uint64_t compared = 0, differing = 0;
   std::string first;
@@ -644,7 +635,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
     covrast::detail::coverage_rows_scalar(*cols, col, row_begin, row_begin + kRows, sign,
                                           scalar.data(), kColumnGroup);
     for (std::int64_t target : targets) {
-      covrast::detail::force_coverage_kernel_target(target);
+      covrast::detail::force_simd_target(target);
       std::fill(simd.begin(), simd.end(), kPoison);
       covrast::detail::coverage_rows_simd(*cols, col, row_begin, row_begin + kRows, sign,
                                           simd.data(), kColumnGroup);
@@ -668,7 +659,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
       }
     }
   }
-  covrast::detail::force_coverage_kernel_target(0);
+  covrast::detail::force_simd_target(0);
   INFO(first);
   CHECK(compared == 3000u * targets.size() * kRows * kColumnGroup);
   CHECK(differing == 0);
@@ -813,7 +804,7 @@ TEST_CASE("coverage set-up: the sorting network orders vertices as std::sort", "
 
 TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[coverage]") {
   const std::vector<std::int64_t> targets =
-      covrast::test::usable_targets(covrast::detail::coverage_kernel_targets());
+      covrast::test::usable_targets();
   REQUIRE(!targets.empty());
   std::mt19937 rng(0x5e7091u);
   auto pick = [&](std::uint32_t n) {
@@ -928,7 +919,7 @@ TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[c
   CHECK(clipped > 5000);
 
   for (std::int64_t target : targets) {
-    covrast::detail::force_coverage_kernel_target(target);
+    covrast::detail::force_simd_target(target);
     INFO("target " << hwy::TargetName(target));
     std::uint64_t differing = 0;
     std::string first;
@@ -963,7 +954,7 @@ TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[c
     INFO(first);
     CHECK(differing == 0);
   }
-  covrast::detail::force_coverage_kernel_target(0);
+  covrast::detail::force_simd_target(0);
 }
 
 // ---- Tessellations: coverages add up to exactly one pixel ------------------------------

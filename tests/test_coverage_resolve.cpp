@@ -20,6 +20,7 @@
 
 #include "raster/coverage/abuffer.hpp"
 #include "test_meshes.hpp"
+#include "test_targets.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -1024,12 +1025,7 @@ Scene default_like_scene() {
 TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD target",
           "[coverage]") {
   const Scene s = default_like_scene();
-  const std::int64_t supported = hwy::SupportedTargets();
-  std::vector<std::int64_t> targets;
-  for (std::int64_t bits = covrast::detail::coverage_kernel_targets() & supported; bits != 0;
-       bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
+  const std::vector<std::int64_t> targets = covrast::test::usable_targets();
   const Image baseline = render(s, ModeKind::Coverage, 1, 64).color;
   // The aliased mode's row kernel dispatches through the same Highway target choice
   // (hwy::SetSupportedTargetsForTest is global), so it is checked here as well.
@@ -1045,7 +1041,7 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
   std::string names;
   for (std::int64_t target : targets) {
     names += std::string(hwy::TargetName(target)) + " ";
-    covrast::detail::force_coverage_kernel_target(target);
+    covrast::detail::force_simd_target(target);
     for (int threads : {1, 2}) {
       for (int tile : {8, 16, 64, 256}) {
         INFO("target " << hwy::TargetName(target) << ", threads " << threads << ", tile " << tile);
@@ -1056,7 +1052,7 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
       }
     }
   }
-  covrast::detail::force_coverage_kernel_target(0);
+  covrast::detail::force_simd_target(0);
   WARN("determinism (coverage and aliased) checked on targets: "
        << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
   CHECK(targets.size() >= 1);

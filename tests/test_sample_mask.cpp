@@ -26,7 +26,7 @@
 
 namespace {
 
-using covrast::detail::force_sample_mask_target;
+using covrast::detail::force_simd_target;
 using covrast::detail::kMaskSamples;
 using covrast::detail::kMaskSampleX_fx9;
 using covrast::detail::kMaskSampleY_fx9;
@@ -121,15 +121,15 @@ std::string describe(const TriangleSetup& t, int x, int y) {
 /// each usable target in turn; restores the best target afterwards.
 void for_each_implementation(const std::function<void(const std::string&, MaskFn)>& check) {
   const std::vector<std::int64_t> targets =
-      covrast::test::usable_targets(covrast::detail::sample_mask_targets());
+      covrast::test::usable_targets();
   REQUIRE(!targets.empty());
   check("scalar", pixel_sample_mask_scalar);
   for (std::int64_t target : targets) {
-    force_sample_mask_target(target);
-    REQUIRE(std::string(covrast::detail::sample_mask_target_name()) == hwy::TargetName(target));
+    force_simd_target(target);
+    REQUIRE(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
     check(hwy::TargetName(target), pixel_sample_mask);
   }
-  force_sample_mask_target(0);
+  force_simd_target(0);
 }
 
 TEST_CASE("sample mask: the lattice has one sample in every fine column and row", "[coverage]") {
@@ -397,7 +397,7 @@ TEST_CASE("sample mask: every SIMD target equals the scalar reference", "[covera
   CHECK(empty > 20000);
 
   std::string names;
-  for (std::int64_t t : covrast::test::usable_targets(covrast::detail::sample_mask_targets()))
+  for (std::int64_t t : covrast::test::usable_targets())
     names += std::string(hwy::TargetName(t)) + " ";
   WARN("sample mask targets compiled and supported here: " << names);
   for_each_implementation([&](const std::string& name, MaskFn mask) {

@@ -4,6 +4,7 @@
 // Most tests drive the tile rasterizers directly with screen triangles built here from
 // 24.8 fixed-point vertices, so the geometry is known exactly and the resolved linear
 // colours can be read before 8-bit encoding; the scene tests go through covrast::render.
+#include "core/simd_target.hpp"
 #include "core/srgb8.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/rasterizers.hpp"
@@ -19,6 +20,8 @@
 #include <hwy/targets.h>
 
 #include <catch2/catch.hpp>
+
+#include "test_targets.hpp"
 
 #include <algorithm>
 #include <array>
@@ -878,7 +881,7 @@ TEST_CASE(
     "[ssaa]") {
   const Scene scene = determinism_scene(97, 61);
   const Scene small = determinism_scene(41, 27);
-  const std::int64_t targets = covrast::detail::sample_kernel_targets() & hwy::SupportedTargets();
+  const std::int64_t targets = covrast::detail::compiled_simd_targets() & hwy::SupportedTargets();
   int forced = 0;
   for (const char* mode : {"ssaa:1", "ssaa:2", "ssaa:3", "ssaa:4", "ssaa:16", "ssaa-grid:5",
                            "ssaa-cmj:1", "ssaa-cmj:2", "ssaa-cmj:3", "ssaa-cmj:4", "ssaa-cmj:16",
@@ -897,10 +900,10 @@ TEST_CASE(
     if (reference) continue;  // no SIMD kernels in the reference mode
     for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
-      covrast::detail::force_sample_kernel_target(target);
+      covrast::detail::force_simd_target(target);
       INFO("target " << hwy::TargetName(target));
       const Image img = render_mode(s, mode, 2, 64).color;
-      covrast::detail::force_sample_kernel_target(0);
+      covrast::detail::force_simd_target(0);
       REQUIRE(img.rgb == base.rgb);
       ++forced;
     }
@@ -914,10 +917,10 @@ TEST_CASE(
   // Forcing really switches the kernels: one distinct function per target.
   std::vector<covrast::detail::SampleGroupFn> kernels;
   for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
-    covrast::detail::force_sample_kernel_target(bits & -bits);
+    covrast::detail::force_simd_target(bits & -bits);
     kernels.push_back(covrast::detail::sample_kernels_simd().sample);
   }
-  covrast::detail::force_sample_kernel_target(0);
+  covrast::detail::force_simd_target(0);
   std::sort(kernels.begin(), kernels.end(), std::less<covrast::detail::SampleGroupFn>());
   REQUIRE(std::unique(kernels.begin(), kernels.end()) - kernels.begin() ==
           std::ptrdiff_t(kernels.size()));
@@ -932,7 +935,7 @@ TEST_CASE(
   REQUIRE(std::unique(colors.begin(), colors.end()) - colors.begin() > 1000);
 }
 
-TEST_CASE("the SIMD kernels and their scalar twins give the same samples", "[ssaa]") {
+TEST_CASE("the sample kernels on every SIMD target give their scalar twins' samples", "[ssaa]") {
   // Flat and vertex-coloured triangles at random depths, some with edges beyond the int32
   // bound (the int64 path), in tiles whose rect starts off the group grid.
   std::mt19937_64 rng(2718);
@@ -970,17 +973,19 @@ TEST_CASE("the SIMD kernels and their scalar twins give the same samples", "[ssa
     wide_triangles += wide;
   }
   REQUIRE(wide_triangles >= 5);
-  for (const SamplePattern& p : patterns) {
-    for (ShadingRate rate : {ShadingRate::PerSample, ShadingRate::PerPixel}) {
-      INFO("samples " << p.size() << ", per "
-                      << (rate == ShadingRate::PerSample ? "sample" : "pixel"));
-      // A small band budget so that the tile is also split into bands.
-      SampleRasterizer simd(32, p, rate, covrast::detail::sample_kernels_simd(), 64 << 10);
-      SampleRasterizer scalar(32, p, rate, covrast::detail::sample_kernels_scalar());
-      REQUIRE(render_tile(simd, 32, rect, tris, background) ==
-              render_tile(scalar, 32, rect, tris, background));
+  covrast::test::for_each_target([&](std::int64_t) {
+    for (const SamplePattern& p : patterns) {
+      for (ShadingRate rate : {ShadingRate::PerSample, ShadingRate::PerPixel}) {
+        INFO("samples " << p.size() << ", per "
+                        << (rate == ShadingRate::PerSample ? "sample" : "pixel"));
+        // A small band budget so that the tile is also split into bands.
+        SampleRasterizer simd(32, p, rate, covrast::detail::sample_kernels_simd(), 64 << 10);
+        SampleRasterizer scalar(32, p, rate, covrast::detail::sample_kernels_scalar());
+        REQUIRE(render_tile(simd, 32, rect, tris, background) ==
+                render_tile(scalar, 32, rect, tris, background));
+      }
     }
-  }
+  });
 }
 
 TEST_CASE("banded replay is reported as raster time, not resolve time", "[ssaa]") {

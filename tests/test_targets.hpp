@@ -1,21 +1,41 @@
-// Test helper shared by the SIMD kernel tests: which Highway targets to force.
+// Test helper shared by the SIMD kernel tests: which Highway targets to force, and a loop
+// that runs a check once per target with the target's name on every failure.
 #pragma once
+
+#include "core/simd_target.hpp"
 
 #include <hwy/targets.h>
 
+#include <catch2/catch.hpp>
+
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace covrast::test {
 
-/// The Highway targets among `compiled` (HWY_* bit flags) that this CPU supports, best first.
-/// Call before forcing any target: hwy::SupportedTargets() reports the mock once one is set.
-inline std::vector<std::int64_t> usable_targets(std::int64_t compiled) {
+/// The compiled Highway targets that this CPU supports, best first. Read before forcing any
+/// target: hwy::SupportedTargets() reports the mock once one is set.
+inline std::vector<std::int64_t> usable_targets() {
   std::vector<std::int64_t> targets;
-  for (std::int64_t bits = compiled & hwy::SupportedTargets(); bits != 0; bits &= bits - 1) {
-    targets.push_back(bits & -bits);
-  }
+  const std::int64_t usable = covrast::detail::compiled_simd_targets() & hwy::SupportedTargets();
+  for (std::int64_t bits = usable; bits != 0; bits &= bits - 1) targets.push_back(bits & -bits);
   return targets;
+}
+
+/// Runs `check(target)` with each usable target forced in turn (every assertion inside names
+/// the target), then goes back to the best supported target.
+template <class Check>
+void for_each_target(Check check) {
+  const std::int64_t supported = hwy::SupportedTargets();
+  for (const std::int64_t target : usable_targets()) {
+    covrast::detail::force_simd_target(target);
+    INFO("SIMD target " << hwy::TargetName(target));
+    REQUIRE(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
+    check(target);
+  }
+  covrast::detail::force_simd_target(0);
+  CHECK(hwy::SupportedTargets() == supported);
 }
 
 }  // namespace covrast::test

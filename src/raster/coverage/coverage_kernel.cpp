@@ -357,19 +357,5 @@ GroupRows cover_group_simd(const CoverageTriangle& tri, int col, int lanes, int 
   return HWY_DYNAMIC_DISPATCH(CoverGroup)(tri, col, lanes, row_min, row_max, out, stride);
 }
 
-std::int64_t coverage_kernel_targets() { return HWY_TARGETS; }
-
-void force_coverage_kernel_target(std::int64_t target) {
-  hwy::SetSupportedTargetsForTest(target);
-  // Makes the next dispatch pick again among the (now mocked) supported targets.
-  hwy::GetChosenTarget().Update(hwy::SupportedTargets());
-}
-
-const char* coverage_kernel_target_name() {
-  // Lower bits are better targets; dispatch takes the best one compiled and supported.
-  std::int64_t usable = HWY_TARGETS & hwy::SupportedTargets();
-  return hwy::TargetName(usable & -usable);
-}
-
 }  // namespace covrast::detail
 #endif

@@ -72,14 +72,6 @@ void coverage_rows_scalar(const CoverageColumns& columns, int col, int row_begin
 void coverage_rows_simd(const CoverageColumns& columns, int col, int row_begin, int row_end,
                         int sign, std::uint16_t* out, std::size_t stride);
 
-/// Highway targets compiled into this build (bit flags, HWY_* values), for tests and
-/// benchmarks; and a way to force one (0 = back to the best supported). Forcing a target
-/// applies to every dispatched function of this header: the kernel, the column set-up and
-/// the fused group function.
-std::int64_t coverage_kernel_targets();
-void force_coverage_kernel_target(std::int64_t target);
-const char* coverage_kernel_target_name();
-
 /// The three edges of a triangle in the kernel's canonical form.
 struct CoverageEdge {
   double x0, y0, x1, y1;  ///< endpoints in pixels, x0 < x1 or (x0 == x1, y0 <= y1)

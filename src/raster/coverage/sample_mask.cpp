@@ -1,5 +1,5 @@
-// Coverage mode: the 256-sample sub-pixel mask (sample_mask.hpp), scalar reference and SIMD
-// version, one source compiled for every Highway target.
+// Coverage mode: the 256-sample sub-pixel mask (sample_mask.hpp), the SIMD version, one
+// source compiled for every Highway target; its scalar twin is sample_mask_scalar.cpp.
 //
 // Why the SIMD version is exact. In units of 1/512 pixel (fx9) edge e at sample k of pixel
 // (x, y) is, exactly in int64, twice the fx8 edge function:
@@ -121,23 +121,6 @@ std::int64_t corner_term(const EdgeFunction& e, int x, int y) {
 
 }  // namespace
 
-SampleMask pixel_sample_mask_scalar(const TriangleSetup& t, int x, int y) {
-  const TriangleEdges edges(t);
-  const std::int64_t px0 = std::int64_t(x) * kMaskUnitsPerPixel;
-  const std::int64_t py0 = std::int64_t(y) * kMaskUnitsPerPixel;
-  SampleMask mask = SampleMask::none();
-  for (int k = 0; k < kMaskSamples; ++k) {
-    const std::int64_t px = px0 + kMaskSampleX_fx9[std::size_t(k)];
-    const std::int64_t py = py0 + kMaskSampleY_fx9[std::size_t(k)];
-    bool inside = true;
-    for (const EdgeFunction& e : edges.e) {
-      inside = inside && e.dx * (py - 2 * e.y0) - e.dy * (px - 2 * e.x0) + e.bias >= 0;
-    }
-    if (inside) mask.word[k >> 6] |= std::uint64_t(1) << (k & 63);
-  }
-  return mask;
-}
-
 SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
   constexpr std::int64_t kLo = 1, kHi = kMaskUnitsPerPixel - 1;  // sample offsets [fx9]
@@ -161,20 +144,6 @@ SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y) {
   if (crossing.count == 0) return SampleMask::all();
   if (!narrow) return pixel_sample_mask_scalar(t, x, y);
   return HWY_DYNAMIC_DISPATCH(SampleMaskCrossing)(crossing);
-}
-
-std::int64_t sample_mask_targets() { return HWY_TARGETS; }
-
-void force_sample_mask_target(std::int64_t target) {
-  hwy::SetSupportedTargetsForTest(target);
-  // Makes the next dispatch pick again among the (now mocked) supported targets.
-  hwy::GetChosenTarget().Update(hwy::SupportedTargets());
-}
-
-const char* sample_mask_target_name() {
-  // Lower bits are better targets; dispatch takes the best one compiled and supported.
-  const std::int64_t usable = HWY_TARGETS & hwy::SupportedTargets();
-  return hwy::TargetName(usable & -usable);
 }
 
 }  // namespace covrast::detail

@@ -98,11 +98,5 @@ SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y);
 /// The scalar reference: 3 int64 edge functions at each of the 256 samples.
 SampleMask pixel_sample_mask_scalar(const TriangleSetup& t, int x, int y);
 
-/// Highway targets compiled into this file (HWY_* bit flags); forcing one (0 = back to the
-/// best supported) changes the choice for every Highway kernel of the process, as
-/// force_coverage_kernel_target does.
-std::int64_t sample_mask_targets();
-void force_sample_mask_target(std::int64_t target);
-const char* sample_mask_target_name();
 
 }  // namespace covrast::detail

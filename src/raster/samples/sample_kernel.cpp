@@ -250,17 +250,6 @@ SampleKernels sample_kernels_simd() {
       HWY_DISPATCH_TABLE(ClearDepth)[index]};
 }
 
-std::int64_t sample_kernel_targets() { return HWY_TARGETS; }
-
-void force_sample_kernel_target(std::int64_t target) {
-  hwy::SetSupportedTargetsForTest(target);
-  hwy::GetChosenTarget().Update(hwy::SupportedTargets());
-}
-
-const char* sample_kernel_target_name() {
-  std::int64_t usable = HWY_TARGETS & hwy::SupportedTargets();
-  return hwy::TargetName(usable & -usable);
-}
 
 }  // namespace covrast::detail
 #endif

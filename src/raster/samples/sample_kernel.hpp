@@ -150,10 +150,5 @@ SampleKernels sample_kernels_simd();
 /// The scalar twins: the same arithmetic one lane at a time (sample_kernel_scalar.cpp).
 SampleKernels sample_kernels_scalar();
 
-/// Highway targets compiled into this build (HWY_* bit flags); forcing one (0 = back to
-/// the best supported) changes the choice for every Highway kernel of the process.
-std::int64_t sample_kernel_targets();
-void force_sample_kernel_target(std::int64_t target);
-const char* sample_kernel_target_name();
 
 }  // namespace covrast::detail
