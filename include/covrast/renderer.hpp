@@ -36,12 +36,23 @@ struct RenderMode {
 RenderMode parse_render_mode(std::string_view text);
 std::string to_string(const RenderMode& mode);
 
+/// Tile sides RenderOptions::tile accepts [pixels]: kMinTilePx..kMaxTilePx, a multiple of
+/// kTileStepPx (the coverage mode's column groups and A-buffer blocks are 8 pixels wide).
+inline constexpr int kMinTilePx = 8;
+inline constexpr int kMaxTilePx = 256;
+inline constexpr int kTileStepPx = 8;
+constexpr bool valid_tile_px(int tile_px) {
+  return tile_px >= kMinTilePx && tile_px <= kMaxTilePx && tile_px % kTileStepPx == 0;
+}
+/// The accepted tile sides in words, for messages and help texts.
+std::string tile_px_rule();
+
 struct RenderOptions {
   RenderMode mode;
   int width = 0;    ///< 0: the scene's width
   int height = 0;   ///< 0: the scene's height
   int threads = 0;  ///< 0: all hardware threads
-  int tile = 64;    ///< tile side [pixels], 8..256, a multiple of 8
+  int tile = 64;    ///< tile side [pixels], see valid_tile_px
   bool want_depth = false;
   /// Drop the back faces of closed meshes wherever that provably cannot change the image
   /// (eye outside the mesh, no vertex clipped by the near or far plane; see

@@ -24,8 +24,6 @@
 namespace covrast::cli {
 namespace {
 
-constexpr int kMinTile = 8;
-constexpr int kMaxTile = 256;
 constexpr int kMaxThreads = 4096;
 constexpr int kMaxRepeat = 1000;
 
@@ -114,19 +112,19 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str()
       ->type_name("N");
-  sub->add_option("--tile", args.tile, "Tile side in pixels: 8..256, a multiple of 8")
+  sub->add_option("--tile", args.tile, "Tile side in pixels: " + tile_px_rule())
       ->check(CLI::Validator(
           [](std::string& text) -> std::string {
             int value = 0;
             const auto [end, error] =
                 std::from_chars(text.data(), text.data() + text.size(), value);
-            if (error != std::errc() || end != text.data() + text.size() || value < kMinTile ||
-                value > kMaxTile || value % 8 != 0) {
-              return "must be an integer in 8..256 and a multiple of 8, got '" + text + "'";
+            if (error != std::errc() || end != text.data() + text.size() || !valid_tile_px(value)) {
+              return "must be " + tile_px_rule() + ", got '" + text + "'";
             }
             return {};
           },
-          "8..256, multiple of 8"))
+          std::to_string(kMinTilePx) + ".." + std::to_string(kMaxTilePx) + ", multiple of " +
+              std::to_string(kTileStepPx)))
       ->capture_default_str()
       ->type_name("N");
   sub->add_option("--depth", args.depth,

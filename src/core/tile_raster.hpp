@@ -11,6 +11,7 @@
 #include "core/triangle_setup.hpp"
 
 #include <covrast/image.hpp>
+#include <covrast/renderer.hpp>
 
 #include <cstdint>
 #include <memory>
@@ -41,6 +42,6 @@ class TileRasterizer {
 };
 
 /// Largest tile side the rasterizers accept [pixels].
-inline constexpr int kMaxTilePx = 256;
+inline constexpr int kMaxTilePx = covrast::kMaxTilePx;
 
 }  // namespace covrast::detail

@@ -60,6 +60,11 @@ RenderMode parse_render_mode(std::string_view text) {
   return fail();
 }
 
+std::string tile_px_rule() {
+  return "an integer in " + std::to_string(kMinTilePx) + ".." + std::to_string(kMaxTilePx) +
+         " and a multiple of " + std::to_string(kTileStepPx);
+}
+
 std::string to_string(const RenderMode& mode) {
   switch (mode.kind) {
     case ModeKind::Aliased:
@@ -145,10 +150,9 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
     throw InputError("image size " + std::to_string(w) + "x" + std::to_string(h) +
                      " out of range: each side must be 1.." + std::to_string(kMaxImageSide));
   }
-  if (options.tile < 8 || options.tile > detail::kMaxTilePx || options.tile % 8 != 0) {
-    throw InputError("tile size " + std::to_string(options.tile) +
-                     " out of range: must be a multiple of 8 in 8.." +
-                     std::to_string(detail::kMaxTilePx));
+  if (!valid_tile_px(options.tile)) {
+    throw InputError("tile size " + std::to_string(options.tile) + " out of range: must be " +
+                     tile_px_rule());
   }
   if (options.threads < 0) throw InputError("thread count must be >= 0 (0 = all cores)");
   int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();

@@ -143,10 +143,4 @@ std::unique_ptr<TileRasterizer> make_aliased_rasterizer(int tile_px) {
   return std::make_unique<AliasedRasterizer>(tile_px, raster_aliased_simd());
 }
 
-/// The same mode on the scalar twin of the kernel, for tests that compare the two (declare
-/// it where needed; it has no header of its own).
-std::unique_ptr<TileRasterizer> make_aliased_rasterizer_scalar(int tile_px) {
-  return std::make_unique<AliasedRasterizer>(tile_px, &raster_aliased_scalar);
-}
-
 }  // namespace covrast::detail
