@@ -12,6 +12,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "test_meshes.hpp"
+#include "test_tempdir.hpp"
 
 #include <algorithm>
 #include <array>
@@ -277,13 +278,8 @@ TEST_CASE("analysis: load_mesh and load_scene analyse the meshes they load", "[c
   CHECK(sphere->closed_orientation == 1);
   CHECK(sphere->analyzed_triangle_count == sphere->triangle_count());
 
-  struct TempDir {
-    std::filesystem::path path = std::filesystem::temp_directory_path() /
-                                 ("covrast_cull_" + std::to_string(std::random_device{}()));
-    TempDir() { std::filesystem::create_directories(path); }
-    ~TempDir() { std::filesystem::remove_all(path); }
-  } temp;
-  const std::filesystem::path& dir = temp.path;
+  const covrast::test::TempDir temp("covrast-test-cull");
+  const std::filesystem::path& dir = temp.path();
   {
     // The cube, inside out, as OBJ (1-based indices).
     auto m = reversed(cube());

@@ -21,8 +21,11 @@ using DF = hn::CappedTag<float, kGroupLaneBlock>;
 using DI = hn::RebindToSigned<DF>;
 using DU = hn::RebindToUnsigned<DF>;
 
-void SetupGroup(const GroupPattern& pattern, const std::int32_t dx[3], const std::int32_t dy[3],
-                bool with_edges, float dzdx, float dzdy, GroupTriangle& tri) {
+// Inlined into RasterTriangle (the walk calls it once per triangle); SetupGroup is its
+// exported form for the dispatch table.
+HWY_INLINE void SetupGroupImpl(const GroupPattern& pattern, const std::int32_t dx[3],
+                               const std::int32_t dy[3], bool with_edges, float dzdx, float dzdy,
+                               GroupTriangle& tri) {
   const DF df;
   const DI di;
   const std::size_t n = hn::Lanes(df);
@@ -46,6 +49,11 @@ void SetupGroup(const GroupPattern& pattern, const std::int32_t dx[3], const std
       hn::Store(c, di, tri.c[e] + i);
     }
   }
+}
+
+void SetupGroup(const GroupPattern& pattern, const std::int32_t dx[3], const std::int32_t dy[3],
+                bool with_edges, float dzdx, float dzdy, GroupTriangle& tri) {
+  SetupGroupImpl(pattern, dx, dy, with_edges, dzdx, dzdy, tri);
 }
 
 template <bool kTestEdges>
@@ -113,43 +121,17 @@ bool SampleGroup(const GroupPattern& pattern, const GroupTriangle& tri, const st
   return SampleGroupImpl<false>(pattern, tri, f, z_base, rgb, out, written);
 }
 
+#include "raster/samples/sample_walk-inl.hpp"  // walk_triangle_groups, for this target
+
 void RasterTriangle(const GroupPattern& pattern, const RasterJob& job, GroupTriangle& tri) {
-  const std::size_t lanes = std::size_t(pattern.lanes);
-  bool set_up = false;
-  std::int64_t f_row[3] = {job.f[0], job.f[1], job.f[2]};
-  for (int row = 0; row < job.rows; ++row) {
-    const int y = job.y0 + row;
-    const double z_y = job.dzdy * (double(y) - job.vy);
-    std::int64_t f[3] = {f_row[0], f_row[1], f_row[2]};
-    std::size_t lane = std::size_t(row) * job.row_lanes;
-    for (int g = 0; g < job.groups; ++g, lane += lanes) {
-      bool none = false, all_inside = true;
-      std::int32_t f32[3];
-      for (int e = 0; e < 3; ++e) {
-        none |= f[e] + job.c_max[e] < 0;
-        all_inside &= f[e] + job.c_min[e] >= 0;
-        f32[e] = std::int32_t(f[e] < kEdgeClamp ? f[e] : kEdgeClamp);
-        f[e] += job.step_x[e];
-      }
-      if (none) continue;
-      if (!set_up) {
-        SetupGroup(pattern, job.dx, job.dy, true, job.dzdx_f, job.dzdy_f, tri);
-        set_up = true;
-      }
-      const int gx = job.gx0 + g * pattern.group_px;
-      const float z_base = float(job.z0 + job.dzdx * (double(gx) - job.vx) + z_y);
-      const GroupSamples out{job.first.depth + lane, job.first.r + lane, job.first.g + lane,
-                             job.first.b + lane};
-      std::uint64_t written[kMaxGroupLanes / 64] = {0, 0, 0, 0};
-      std::uint64_t* written_ptr = job.rgb != nullptr ? nullptr : written;
-      const bool any =
-          all_inside
-              ? SampleGroupImpl<false>(pattern, tri, nullptr, z_base, job.rgb, out, written_ptr)
-              : SampleGroupImpl<true>(pattern, tri, f32, z_base, job.rgb, out, written_ptr);
-      if (any && job.rgb == nullptr) job.shade_fn(job.shade_context, gx, y, written, out);
-    }
-    for (int e = 0; e < 3; ++e) f_row[e] += job.step_y[e];
-  }
+  walk_triangle_groups(
+      pattern, job,
+      [&] { SetupGroupImpl(pattern, job.dx, job.dy, true, job.dzdx_f, job.dzdy_f, tri); },
+      [&](const std::int32_t* f32, float z_base, const GroupSamples& out, std::uint64_t* written) {
+        return f32 == nullptr
+                   ? SampleGroupImpl<false>(pattern, tri, nullptr, z_base, job.rgb, out, written)
+                   : SampleGroupImpl<true>(pattern, tri, f32, z_base, job.rgb, out, written);
+      });
 }
 
 void ResolvePixels(const GroupPattern& pattern, int pixels, const GroupSamples& in,
@@ -249,7 +231,6 @@ SampleKernels sample_kernels_simd() {
       HWY_DISPATCH_TABLE(RasterTriangle)[index], HWY_DISPATCH_TABLE(ResolvePixels)[index],
       HWY_DISPATCH_TABLE(ClearDepth)[index]};
 }
-
 
 }  // namespace covrast::detail
 #endif
