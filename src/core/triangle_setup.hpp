@@ -66,18 +66,22 @@ struct PixelRect {
   bool empty() const { return x0 >= x1 || y0 >= y1; }
 };
 
-/// Pixels that the triangle's area can touch: floor of the minimum to ceil of the maximum.
-inline PixelRect touched_pixels(const TriangleSetup& t) {
+/// Pixels that a triangle with these vertices [fx8, any order] can touch: floor of the
+/// minimum to ceil of the maximum.
+inline PixelRect touched_pixels(const std::int32_t (&x_fx8)[3], const std::int32_t (&y_fx8)[3]) {
   // Pairwise min/max (the initializer-list forms compile to a loop with branches).
-  const std::int32_t minx = std::min(t.x_fx8[0], std::min(t.x_fx8[1], t.x_fx8[2]));
-  const std::int32_t maxx = std::max(t.x_fx8[0], std::max(t.x_fx8[1], t.x_fx8[2]));
-  const std::int32_t miny = std::min(t.y_fx8[0], std::min(t.y_fx8[1], t.y_fx8[2]));
-  const std::int32_t maxy = std::max(t.y_fx8[0], std::max(t.y_fx8[1], t.y_fx8[2]));
+  const std::int32_t minx = std::min(x_fx8[0], std::min(x_fx8[1], x_fx8[2]));
+  const std::int32_t maxx = std::max(x_fx8[0], std::max(x_fx8[1], x_fx8[2]));
+  const std::int32_t miny = std::min(y_fx8[0], std::min(y_fx8[1], y_fx8[2]));
+  const std::int32_t maxy = std::max(y_fx8[0], std::max(y_fx8[1], y_fx8[2]));
   // Arithmetic shift = floor division by 256 for negative values too.
   return PixelRect{minx >> kSubpixelBits, miny >> kSubpixelBits,
                    (maxx + kSubpixelOne - 1) >> kSubpixelBits,
                    (maxy + kSubpixelOne - 1) >> kSubpixelBits};
 }
+
+/// Pixels that the triangle's area can touch.
+inline PixelRect touched_pixels(const TriangleSetup& t) { return touched_pixels(t.x_fx8, t.y_fx8); }
 
 /// touched_pixels clamped to the image, in 16 bits (image sides are at most 16384 px):
 /// all that binning needs, 8 bytes per triangle instead of the whole setup.

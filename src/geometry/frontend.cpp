@@ -522,14 +522,9 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     ++sink.counters.culled;
     return;
   }
-  // Reject triangles wholly outside the image (touched_pixels of the vertices, in any order).
-  const std::int32_t minx = std::min(v0.x_fx8, std::min(v1.x_fx8, v2.x_fx8));
-  const std::int32_t maxx = std::max(v0.x_fx8, std::max(v1.x_fx8, v2.x_fx8));
-  const std::int32_t miny = std::min(v0.y_fx8, std::min(v1.y_fx8, v2.y_fx8));
-  const std::int32_t maxy = std::max(v0.y_fx8, std::max(v1.y_fx8, v2.y_fx8));
-  const PixelRect r{minx >> kSubpixelBits, miny >> kSubpixelBits,
-                    (maxx + kSubpixelOne - 1) >> kSubpixelBits,
-                    (maxy + kSubpixelOne - 1) >> kSubpixelBits};
+  // Reject triangles wholly outside the image.
+  const PixelRect r =
+      touched_pixels({v0.x_fx8, v1.x_fx8, v2.x_fx8}, {v0.y_fx8, v1.y_fx8, v2.y_fx8});
   if (r.x1 <= 0 || r.y1 <= 0 || r.x0 >= width_px_ || r.y0 >= height_px_) {
     ++sink.counters.culled;
     return;
