@@ -802,21 +802,19 @@ TEST_CASE("coverage set-up: the sorting network orders vertices as std::sort", "
   CHECK(mismatches == 0);
 }
 
-TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[coverage]") {
-  const std::vector<std::int64_t> targets =
-      covrast::test::usable_targets();
-  REQUIRE(!targets.empty());
-  std::mt19937 rng(0x5e7091u);
+namespace {
+
+/// Triangles for the set-up comparison: the kernel tests' mix (ordinary, slivers, in-pixel,
+/// on the pixel grid, huge up to +-16384 px), right triangles with a vertical and a
+/// horizontal edge (on pixel borders half of the time), and small triangles far out at up
+/// to +-16384 px.
+std::vector<TriangleSetup> setup_test_triangles(std::mt19937& rng) {
   auto pick = [&](std::uint32_t n) {
     return std::uniform_int_distribution<std::uint32_t>(0, n - 1)(rng);
   };
   auto uniform = [&](double lo, double hi) {
     return std::uniform_real_distribution<double>(lo, hi)(rng);
   };
-
-  // Triangles: the kernel tests' mix (ordinary, slivers, in-pixel, on the pixel grid, huge
-  // up to +-16384 px), right triangles with a vertical and a horizontal edge (on pixel
-  // borders half of the time), and small triangles far out at up to +-16384 px.
   std::vector<TriangleSetup> tris;
   TriangleGenerator gen(0x5e7091u);
   for (const KindCount& kc : kMix) {
@@ -845,9 +843,17 @@ TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[c
     if (make_setup(a, b, c, t)) tris.push_back(t);
   }
 
-  // Groups: the rasterizer's own (every group of the box, the last one partial), random
-  // groups that overhang the box or lie outside it with 0..8 lanes, and row windows that are
-  // the box's rows, cut through the triangle, or miss it.
+  return tris;
+}
+
+/// Column groups for the set-up comparison: the rasterizer's own (every group of the box,
+/// the last one partial), random groups that overhang the box or lie outside it with 0..8
+/// lanes, and row windows that are the box's rows, cut through the triangle, or miss it.
+std::vector<SetupCase> setup_test_groups(const std::vector<TriangleSetup>& tris,
+                                         std::mt19937& rng) {
+  auto pick = [&](std::uint32_t n) {
+    return std::uniform_int_distribution<std::uint32_t>(0, n - 1)(rng);
+  };
   std::vector<SetupCase> cases;
   for (const TriangleSetup& t : tris) {
     const PixelRect box = covrast::detail::touched_pixels(t);
@@ -891,70 +897,99 @@ TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[c
     }
   }
 
-  // The scalar twin's results, once.
-  auto scalar_cols = std::make_unique<CoverageColumns>();
-  auto simd_cols = std::make_unique<CoverageColumns>();
-  std::vector<GroupRows> scalar_rows(cases.size());
+  return cases;
+}
+
+/// The scalar twin's rows for every case, and how many cases are partial groups, empty, with
+/// an interior run, or clipped by their row window (the branches the comparison must reach).
+struct ScalarSetup {
+  std::vector<GroupRows> rows;
   std::uint64_t partial = 0, empty = 0, interior = 0, clipped = 0;
+};
+ScalarSetup run_scalar_setup(const std::vector<SetupCase>& cases) {
+  auto scalar_cols = std::make_unique<CoverageColumns>();
+  ScalarSetup out;
+  out.rows.resize(cases.size());
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const SetupCase& sc = cases[i];
     const CoverageTriangle tri = covrast::detail::make_coverage_triangle(sc.setup);
     const GroupRows g = covrast::detail::setup_column_group_scalar(
         tri, sc.col, sc.lanes, sc.row_min, sc.row_max, *scalar_cols);
-    scalar_rows[i] = g;
-    partial += sc.lanes < kColumnGroup;
-    empty += g.empty();
-    interior += g.interior_begin < g.interior_end;
+    out.rows[i] = g;
+    out.partial += sc.lanes < kColumnGroup;
+    out.empty += g.empty();
+    out.interior += g.interior_begin < g.interior_end;
     const GroupRows unclipped = covrast::detail::setup_column_group_scalar(
         tri, sc.col, sc.lanes, INT_MIN / 2, INT_MAX / 2, *scalar_cols);
-    clipped += !g.empty() && (g.first != unclipped.first || g.end != unclipped.end);
+    out.clipped += !g.empty() && (g.first != unclipped.first || g.end != unclipped.end);
   }
-  WARN("column set-up: " << tris.size() << " triangles, " << cases.size() << " groups (" << partial
-                         << " partial, " << empty << " empty, " << interior
-                         << " with an interior run, " << clipped << " clipped) on "
-                         << targets.size() << " targets");
-  CHECK(partial > 20000);
-  CHECK(empty > 2000);
-  CHECK(interior > 5000);
-  CHECK(clipped > 5000);
+  return out;
+}
 
-  for (std::int64_t target : targets) {
-    covrast::detail::force_simd_target(target);
-    INFO("target " << hwy::TargetName(target));
-    std::uint64_t differing = 0;
-    std::string first;
-    for (std::size_t i = 0; i < cases.size(); ++i) {
-      const SetupCase& sc = cases[i];
-      const CoverageTriangle tri = covrast::detail::make_coverage_triangle(sc.setup);
-      poison_group(*scalar_cols, 0x7fc00010u);
-      poison_group(*simd_cols, 0x7fc00020u);
-      covrast::detail::setup_column_group_scalar(tri, sc.col, sc.lanes, sc.row_min, sc.row_max,
-                                                 *scalar_cols);
-      const GroupRows g = covrast::detail::setup_column_group(tri, sc.col, sc.lanes, sc.row_min,
-                                                              sc.row_max, *simd_cols);
-      const GroupRows& ref = scalar_rows[i];
-      std::string what;
-      if (g.first != ref.first || g.end != ref.end || g.interior_begin != ref.interior_begin ||
-          g.interior_end != ref.interior_end) {
-        std::ostringstream s;
-        s << "rows simd (" << g.first << ", " << g.end << ", " << g.interior_begin << ", "
-          << g.interior_end << "), scalar (" << ref.first << ", " << ref.end << ", "
-          << ref.interior_begin << ", " << ref.interior_end << ")";
-        what = s.str();
-      } else if (same_group(*simd_cols, *scalar_cols, what)) {
-        continue;
-      }
-      if (++differing == 1) {
-        std::ostringstream s;
-        s << describe(sc.setup) << " col " << sc.col << " lanes " << sc.lanes << " rows ["
-          << sc.row_min << ", " << sc.row_max << "): " << what;
-        first = s.str();
-      }
+/// The first difference between the SIMD and the scalar set-up over `cases` (empty: none),
+/// and how many cases differ.
+std::string first_setup_difference(const std::vector<SetupCase>& cases,
+                                   const std::vector<GroupRows>& scalar_rows,
+                                   std::uint64_t& differing) {
+  auto scalar_cols = std::make_unique<CoverageColumns>();
+  auto simd_cols = std::make_unique<CoverageColumns>();
+  differing = 0;
+  std::string first;
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const SetupCase& sc = cases[i];
+    const CoverageTriangle tri = covrast::detail::make_coverage_triangle(sc.setup);
+    poison_group(*scalar_cols, 0x7fc00010u);
+    poison_group(*simd_cols, 0x7fc00020u);
+    covrast::detail::setup_column_group_scalar(tri, sc.col, sc.lanes, sc.row_min, sc.row_max,
+                                               *scalar_cols);
+    const GroupRows g = covrast::detail::setup_column_group(tri, sc.col, sc.lanes, sc.row_min,
+                                                            sc.row_max, *simd_cols);
+    const GroupRows& ref = scalar_rows[i];
+    std::string what;
+    if (g.first != ref.first || g.end != ref.end || g.interior_begin != ref.interior_begin ||
+        g.interior_end != ref.interior_end) {
+      std::ostringstream s;
+      s << "rows simd (" << g.first << ", " << g.end << ", " << g.interior_begin << ", "
+        << g.interior_end << "), scalar (" << ref.first << ", " << ref.end << ", "
+        << ref.interior_begin << ", " << ref.interior_end << ")";
+      what = s.str();
+    } else if (same_group(*simd_cols, *scalar_cols, what)) {
+      continue;
     }
+    if (++differing == 1) {
+      std::ostringstream s;
+      s << describe(sc.setup) << " col " << sc.col << " lanes " << sc.lanes << " rows ["
+        << sc.row_min << ", " << sc.row_max << "): " << what;
+      first = s.str();
+    }
+  }
+  return first;
+}
+
+}  // namespace
+
+TEST_CASE("coverage set-up: every SIMD target gives the scalar twin's bits", "[coverage]") {
+  REQUIRE(!covrast::test::usable_targets().empty());
+  std::mt19937 rng(0x5e7091u);
+  const std::vector<TriangleSetup> tris = setup_test_triangles(rng);
+  const std::vector<SetupCase> cases = setup_test_groups(tris, rng);
+  const ScalarSetup scalar = run_scalar_setup(cases);
+  WARN("column set-up: " << tris.size() << " triangles, " << cases.size() << " groups ("
+                         << scalar.partial << " partial, " << scalar.empty << " empty, "
+                         << scalar.interior << " with an interior run, " << scalar.clipped
+                         << " clipped) on " << covrast::test::usable_targets().size()
+                         << " targets");
+  CHECK(scalar.partial > 20000);
+  CHECK(scalar.empty > 2000);
+  CHECK(scalar.interior > 5000);
+  CHECK(scalar.clipped > 5000);
+
+  covrast::test::for_each_target([&](std::int64_t) {
+    std::uint64_t differing = 0;
+    const std::string first = first_setup_difference(cases, scalar.rows, differing);
     INFO(first);
     CHECK(differing == 0);
-  }
-  covrast::detail::force_simd_target(0);
+  });
 }
 
 // ---- Tessellations: coverages add up to exactly one pixel ------------------------------
