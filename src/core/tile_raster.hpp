@@ -11,7 +11,6 @@
 #include "core/triangle_setup.hpp"
 
 #include <covrast/image.hpp>
-#include <covrast/renderer.hpp>
 
 #include <cstdint>
 #include <memory>
@@ -42,6 +41,6 @@ class TileRasterizer {
 };
 
 /// Largest tile side the rasterizers accept [pixels].
-inline constexpr int kMaxTilePx = covrast::kMaxTilePx;
+inline constexpr int kMaxTilePx = 256;  ///< = covrast::kMaxTilePx (pipeline checks)
 
 }  // namespace covrast::detail

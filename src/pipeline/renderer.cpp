@@ -60,6 +60,9 @@ RenderMode parse_render_mode(std::string_view text) {
   return fail();
 }
 
+// The raster's buffers are sized for the API's largest tile.
+static_assert(detail::kMaxTilePx == kMaxTilePx);
+
 std::string tile_px_rule() {
   return "an integer in " + std::to_string(kMinTilePx) + ".." + std::to_string(kMaxTilePx) +
          " and a multiple of " + std::to_string(kTileStepPx);
