@@ -9,10 +9,19 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 gxx_bin=${1:-build/release/covrast}
 clang_dir=build/clang-check
+log="$clang_dir.log"
+echo "check-compilers: building everything with clang in $clang_dir (a few minutes; log: $log)"
 cmake -S . -B "$clang_dir" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
-  -DCOVRAST_WERROR=ON >/dev/null
-cmake --build "$clang_dir" -j 2 >/dev/null
-"$clang_dir/tests/covrast_tests" --order decl >/dev/null
+  -DCOVRAST_WERROR=ON >"$log" 2>&1 || { tail -40 "$log"; exit 1; }
+# Ninja's "[k/n]" lines, one in 25 and the last, as progress; the whole log on failure.
+if ! cmake --build "$clang_dir" -j 2 2>&1 | tee -a "$log" |
+  awk '/^\[[0-9]+\/[0-9]+\]/ { split(substr($1, 2), k, "/"); k[2] = k[2] + 0;
+        if (k[1] % 25 == 0 || k[1] == k[2]) print "check-compilers: clang build " $1 }'; then
+  tail -40 "$log"
+  exit 1
+fi
+echo "check-compilers: running the clang-built test suite"
+"$clang_dir/tests/covrast_tests" --order decl >>"$log" 2>&1 || { tail -40 "$log"; exit 1; }
 echo "clang build: warnings as errors, test suite passed"
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Renders the pictures of docs/coverage.md with covrast itself. Needs ImageMagick only to
-# crop and enlarge (installed here, not a build dependency). Usage: scripts/make-doc-images.sh [BUILD_DIR]
+# Renders the pictures of docs/coverage.md and the README with covrast itself. Needs
+# ImageMagick only to crop and enlarge (installed here, not a build dependency). The test
+# "docs: the pictures show what this build renders" fails when they are stale.
+# Usage: scripts/make-doc-images.sh [BUILD_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build=${1:-build/release}
@@ -20,4 +22,5 @@ for mode in aliased coverage-blend coverage; do
     -resize 600% "$out/seams-$mode.png"
 done
 cp "$tmp/default-coverage.png" "$out/default-coverage.png"
+"$build/covrast" render scenes/lit.json -o "$out/lit.png" --quiet
 echo "wrote $out"

@@ -1,14 +1,26 @@
 #!/usr/bin/env bash
-# Installs the Debian packages covrast needs to build and test (Debian 12). Idempotent: asks
+# Installs the Debian packages covrast needs to build and test (Debian 12); with --build-only,
+# just what building the executable needs (no clang). Idempotent: asks
 # dpkg-query which packages are missing and installs only those; when none is missing it does
 # not call apt-get at all. Runs as root (the CI case) or through sudo when available.
 set -euo pipefail
 
-packages=(
-  cmake ninja-build g++ clang pkg-config
+# What building the covrast executable needs (configuring also finds Catch2 and Google
+# Benchmark, so they are here too: two small header/library packages).
+build_packages=(
+  cmake ninja-build g++ pkg-config
   libglm-dev libtbb-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
-  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev python3
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev
 )
+# What the whole test suite needs besides: clang for the second-compiler check, python3 for
+# the scene and report scripts.
+test_packages=(clang python3)
+
+# Usage: scripts/setup.sh [--build-only]
+packages=("${build_packages[@]}")
+if [[ "${1:-}" != --build-only ]]; then
+  packages+=("${test_packages[@]}")
+fi
 
 missing=()
 for package in "${packages[@]}"; do
