@@ -43,23 +43,24 @@ struct Encoder {
   }
 };
 
-const Encoder& encoder() {
-  static const Encoder e;
-  return e;
+/// Built once at start-up (no guard on every call, as a function-local static would need);
+/// nothing encodes during static initialisation.
+const Encoder g_encoder;
+
+/// encode_srgb8's body, inlined into the tile copy-out, which runs it for every pixel.
+inline std::uint8_t encode(float linear) {
+  // The result is the number of thresholds <= linear, i.e. round(255 * srgb(linear)).
+  if (!(linear > 0.0f)) return 0;
+  if (linear >= 1.0f) return 255;
+  // float(i) / kBuckets <= linear for i = floor(linear * kBuckets): exact power-of-2 scaling.
+  int code = g_encoder.start[int(linear * kBuckets)];
+  while (g_encoder.threshold[code] <= linear) ++code;
+  return std::uint8_t(code);
 }
 
 }  // namespace
 
-std::uint8_t encode_srgb8(float linear) {
-  // The result is the number of thresholds <= linear, i.e. round(255 * srgb(linear)).
-  if (!(linear > 0.0f)) return 0;
-  if (linear >= 1.0f) return 255;
-  const Encoder& e = encoder();
-  // float(i) / kBuckets <= linear for i = floor(linear * kBuckets): exact power-of-2 scaling.
-  int code = e.start[int(linear * kBuckets)];
-  while (e.threshold[code] <= linear) ++code;
-  return std::uint8_t(code);
-}
+std::uint8_t encode_srgb8(float linear) { return encode(linear); }
 
 void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec3* linear,
                 const float* depth, int stride) {
@@ -72,9 +73,9 @@ void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec
     for (int x = rect.x0; x < rect.x1; ++x, ++src, dst += 3) {
       if (*src != last) {
         last = *src;
-        code[0] = encode_srgb8(src->r);
-        code[1] = encode_srgb8(src->g);
-        code[2] = encode_srgb8(src->b);
+        code[0] = encode(src->r);
+        code[1] = encode(src->g);
+        code[2] = encode(src->b);
       }
       dst[0] = code[0];
       dst[1] = code[1];

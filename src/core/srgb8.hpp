@@ -10,8 +10,9 @@
 
 namespace covrast::detail {
 
-/// round(255 * linear_to_srgb(x)) for x in [0, 1] (clamped), by binary search over the
-/// 255 linear values where the 8-bit code changes: exact, and identical on every path.
+/// round(255 * linear_to_srgb(x)) for x in [0, 1] (clamped), from the 255 linear values where
+/// the 8-bit code changes (a bucket table gives the start, a few threshold steps the code):
+/// exact, and identical on every path.
 std::uint8_t encode_srgb8(float linear);
 
 /// A window depth as the depth outputs store it, in [0, 1]: a plane evaluated at a pixel

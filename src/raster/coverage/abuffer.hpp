@@ -210,8 +210,10 @@ class ABufferTile {
   /// Turns a pixel's list into 256 sub-pixel samples (see PixelSamples) and frees it.
   void to_samples(std::size_t pixel, int x, int y);
   /// Draws triangle `t` into a sampled pixel's samples: nearest wins, equal depth keeps the
-  /// earlier triangle.
-  void add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t);
+  /// earlier triangle. Returns whether it won any sample.
+  bool add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t);
+  /// Lowers the pixel's occluder_z_ to (just behind) its farthest sample depth.
+  void bound_by_samples(std::size_t pixel);
   /// A sampled pixel's colour: the mean of its samples' winners' colours (and its depth).
   glm::vec3 resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
   /// Merges triangle `t`'s piece (coverage, sample mask, colour at the pixel centre) into
@@ -287,7 +289,7 @@ class ABufferTile {
   std::vector<std::uint8_t> open_count_;    ///< per pixel, fragments in the open set
   std::vector<std::uint8_t> closed_count_;  ///< per pixel, fragments in the closed set
   /// Per pixel, a depth at or behind which nothing is visible: the farthest depth of the
-  /// closed sets so far (+inf: none).
+  /// closed sets so far, or (a margin behind) of a sampled pixel's samples (+inf: none).
   std::vector<double> occluder_z_;
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
@@ -297,7 +299,13 @@ class ABufferTile {
   /// MSAA-like cost per fragment, however many arrive; the pixel's tail_ holds its index.
   struct PixelSamples {
     double z[kMaskSamples];
+    /// The winner's primitive index, for the tie rule (0 for the background, which a tie
+    /// never takes from: a finite plane is never level with its infinite depth anyway).
+    std::uint64_t primitive[kMaskSamples];
     const TriangleSetup* winner[kMaskSamples];
+    /// How many of the pixel's samples the winner owns (its mask's count, kept from when it
+    /// was drawn so that the resolve does not compute the mask again).
+    std::uint16_t winner_owned[kMaskSamples];
   };
   std::vector<PixelSamples> samples_;
   std::vector<glm::vec3> color_;  ///< resolved linear colour
@@ -332,7 +340,7 @@ inline void ABufferTile::prepare_row(int x0, int x1, int y) {
 inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                              double centre_z) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
-  if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set
+  if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set or samples
   // Hidden by the closed set: behind (or level with, being later) every member it overlaps.
   if (closed_count_[pixel] != 0 && behind_closed_set(pixel, *t, [&](const TriangleSetup& m) {
         return order_of(*t, m, x, y) == DepthOrder::Behind;
@@ -345,7 +353,7 @@ inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t
         order_against_opaque(*t, centre_z, pixel, x, y) == DepthOrder::Behind) {
       return;
     }
-    add_to_samples(pixel, x, y, *t);
+    if (add_to_samples(pixel, x, y, *t)) bound_by_samples(pixel);
     return;
   }
   if (opaque_[pixel] == nullptr) {

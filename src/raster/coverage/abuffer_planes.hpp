@@ -129,22 +129,6 @@ inline bool inner_point(const ClipPolygon& poly, double& px, double& py) {
   return true;
 }
 
-/// Sample offsets from the pixel's corner [pixels], exact in double.
-inline constexpr auto kSampleOffsetX = [] {
-  std::array<double, kMaskSamples> offset{};
-  for (int k = 0; k < kMaskSamples; ++k) {
-    offset[std::size_t(k)] = double(kMaskSampleX_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
-  }
-  return offset;
-}();
-inline constexpr auto kSampleOffsetY = [] {
-  std::array<double, kMaskSamples> offset{};
-  for (int k = 0; k < kMaskSamples; ++k) {
-    offset[std::size_t(k)] = double(kMaskSampleY_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
-  }
-  return offset;
-}();
-
 /// A triangle's plane at the samples of one pixel: z(k) = z0 + dz/dx * x(k) + dz/dy * y(k),
 /// z0 its depth at the pixel's corner, (x(k), y(k)) sample k's offset. Every comparison of
 /// sample_weights uses this expression (no contraction: -ffp-contract=off), so its results

@@ -4,6 +4,7 @@
 
 #include "core/shading.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/sample_depth.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -14,7 +15,7 @@ bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const Trian
                                     std::uint32_t coverage, double centre_z) {
   ++overflows_;
   if (layer_[pixel] == Layer::Sampled) {
-    add_to_samples(pixel, x, y, *t);
+    if (add_to_samples(pixel, x, y, *t)) bound_by_samples(pixel);
     return true;
   }
   if (open_count_[pixel] != 0 && joins_open_set(pixel, *t) &&
@@ -22,7 +23,7 @@ bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const Trian
     return true;
   }
   to_samples(pixel, x, y);
-  add_to_samples(pixel, x, y, *t);
+  if (add_to_samples(pixel, x, y, *t)) bound_by_samples(pixel);
   return true;
 }
 
@@ -37,7 +38,11 @@ void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
   } else {
     std::fill(samples.z, samples.z + kMaskSamples, kFar);
   }
+  std::fill(samples.primitive, samples.primitive + kMaskSamples,
+            opaque != nullptr ? opaque->primitive : 0);
   std::fill(samples.winner, samples.winner + kMaskSamples, opaque);
+  const int opaque_owned = opaque != nullptr ? pixel_sample_mask(*opaque, x, y).count() : 0;
+  std::fill(samples.winner_owned, samples.winner_owned + kMaskSamples, std::uint16_t(opaque_owned));
   // The stored fragments, in list order (merged ones by their pieces, which they always know:
   // merges happen only inside the open set), then the list is gone.
   const std::uint32_t head = head_[pixel];
@@ -54,21 +59,39 @@ void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
   }
   head_[pixel] = kEnd;
   open_count_[pixel] = closed_count_[pixel] = 0;
+  bound_by_samples(pixel);
 }
 
-void ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t) {
+void ABufferTile::bound_by_samples(std::size_t pixel) {
+  // The farthest sample depth: a later triangle whose plane lies behind it all over the pixel
+  // wins no sample (ties go to the earlier triangle, and later ones come later in the
+  // primitive order too), so add() drops it before computing a mask. Four running maxima so
+  // that the loop has no carried dependency of one compare per sample.
+  const PixelSamples& samples = samples_[tail_[pixel]];
+  double far[4] = {samples.z[0], samples.z[1], samples.z[2], samples.z[3]};
+  for (int s = 4; s < kMaskSamples; s += 4) {
+    for (int k = 0; k < 4; ++k) far[k] = samples.z[s + k] > far[k] ? samples.z[s + k] : far[k];
+  }
+  const double farthest = std::max(std::max(far[0], far[1]), std::max(far[2], far[3]));
+  // The margin keeps the test on the safe side of the rounding of the centre depth, the
+  // reach and each sample's plane value (all within 1e-15 of their exact values in [0, 1]).
+  constexpr double kMargin = 1e-9;
+  occluder_z_[pixel] = std::min(occluder_z_[pixel], farthest + kMargin);
+}
+
+bool ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t) {
   PixelSamples& samples = samples_[tail_[pixel]];
   const SampleMask mask = pixel_sample_mask(t, x, y);
   const SamplePlane plane(t, x, y);
-  for_each_sample(mask, [&](int s) {
-    const double z = plane.at(s);
-    const TriangleSetup* w = samples.winner[s];
-    // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
-    if (z < samples.z[s] || (z == samples.z[s] && w != nullptr && t.primitive < w->primitive)) {
-      samples.z[s] = z;
-      samples.winner[s] = &t;
-    }
+  // The order of sample_weights: nearer wins; at equal depth the earlier triangle.
+  const SampleMask won = depth_test_samples(PixelPlane{plane.z0, plane.dzdx, plane.dzdy}, mask,
+                                            t.primitive, samples.z, samples.primitive);
+  const auto owned = std::uint16_t(mask.count());
+  for_each_sample(won, [&](int s) {
+    samples.winner[s] = &t;
+    samples.winner_owned[s] = owned;
   });
+  return won != SampleMask::none();
 }
 
 glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,
@@ -80,7 +103,7 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
   // still cover the pixel, and no background leaks where none shows.
   const PixelSamples& samples = samples_[tail_[pixel]];
   const TriangleSetup* winner[kMaskSamples];
-  int won[kMaskSamples];
+  int won[kMaskSamples], owned[kMaskSamples];
   int winners = 0, background_won = 0;
   const TriangleSetup* last = nullptr;
   int last_slot = -1;
@@ -97,6 +120,7 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
       last_slot = int(std::find(winner, winner + winners, w) - winner);
       if (last_slot == winners) {
         winner[winners] = w;
+        owned[winners] = samples.winner_owned[s];
         won[winners++] = 0;
       }
     }
@@ -105,9 +129,9 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
   double weight[kMaskSamples];
   double total = 0.0;
   for (int k = 0; k < winners; ++k) {
-    const int owned = pixel_sample_mask(*winner[k], x, y).count();
     const double area = std::clamp(polygon_area(part_in_pixel(*winner[k], x, y)), 0.0, 1.0);
-    weight[k] = owned > 0 && area > 0.0 ? area * won[k] / owned : double(won[k]) / kMaskSamples;
+    weight[k] =
+        owned[k] > 0 && area > 0.0 ? area * won[k] / owned[k] : double(won[k]) / kMaskSamples;
     total += weight[k];
   }
   const double background_share = double(background_won) / kMaskSamples;

@@ -4,6 +4,7 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/sample_depth.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
 
 #include <algorithm>
@@ -74,7 +75,7 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
                                 const MergedPiece* const* merged, double* weight,
                                 bool* estimated) const {
   double best_z[kMaskSamples];
-  std::uint32_t best_primitive[kMaskSamples];
+  std::uint64_t best_primitive[kMaskSamples];
   // Per sample, the fragment nearest so far plus one (0: none); once every fragment is
   // tested, won[k + 1] counts the samples fragment k holds and won[0] those the opaque
   // surface or the background keeps.
@@ -88,21 +89,16 @@ int ABufferTile::sample_weights(int x, int y, const TriangleSetup* opaque, int n
     std::fill(best_z, best_z + kMaskSamples, std::numeric_limits<double>::infinity());
   }
   std::fill(best_primitive, best_primitive + kMaskSamples,
-            opaque != nullptr ? opaque->primitive : kNoTriangle);
+            std::uint64_t(opaque != nullptr ? opaque->primitive : kNoTriangle));
   std::memset(best, 0, sizeof(best));
   // Samples `owned` of triangle `t`, for fragment i: nearest wins; equal depth keeps the
   // earlier triangle. The (depth, primitive) order is total, so the winner does not depend
   // on the order fragments are visited in.
   auto depth_test = [&](const SampleMask& owned, const TriangleSetup& t, int i) {
     const SamplePlane plane(t, x, y);
-    for_each_sample(owned, [&](int s) {
-      const double z = plane.at(s);
-      if (z < best_z[s] || (z == best_z[s] && t.primitive < best_primitive[s])) {
-        best_z[s] = z;
-        best_primitive[s] = t.primitive;
-        best[s] = std::uint8_t(i + 1);
-      }
-    });
+    const SampleMask won = depth_test_samples(PixelPlane{plane.z0, plane.dzdx, plane.dzdy}, owned,
+                                              t.primitive, best_z, best_primitive);
+    for_each_sample(won, [&](int s) { best[s] = std::uint8_t(i + 1); });
   };
   SampleMask mask[kMaxFragmentsPerPixel];
   for (int i = 0; i < n; ++i) {

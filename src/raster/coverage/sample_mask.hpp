@@ -54,6 +54,22 @@ inline constexpr std::array<std::int32_t, kMaskSamples> kMaskSampleY_fx9 = [] {
   return y;
 }();
 
+/// Sample offsets from the pixel's corner [pixels], exact in double.
+inline constexpr auto kSampleOffsetX = [] {
+  std::array<double, kMaskSamples> offset{};
+  for (int k = 0; k < kMaskSamples; ++k) {
+    offset[std::size_t(k)] = double(kMaskSampleX_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
+  }
+  return offset;
+}();
+inline constexpr auto kSampleOffsetY = [] {
+  std::array<double, kMaskSamples> offset{};
+  for (int k = 0; k < kMaskSamples; ++k) {
+    offset[std::size_t(k)] = double(kMaskSampleY_fx9[std::size_t(k)]) / kMaskUnitsPerPixel;
+  }
+  return offset;
+}();
+
 /// 256 sample bits: sample k is bit k % 64 of word k / 64.
 struct SampleMask {
   std::uint64_t word[kMaskSamples / 64];
@@ -97,6 +113,5 @@ SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y);
 
 /// The scalar reference: 3 int64 edge functions at each of the 256 samples.
 SampleMask pixel_sample_mask_scalar(const TriangleSetup& t, int x, int y);
-
 
 }  // namespace covrast::detail
