@@ -11,7 +11,7 @@ namespace covrast {
 /// Bad input or usage. what() is one line that names the file (when there is one) and
 /// the problem, e.g. "scenes/a.json:3:14: expected ',' or '}'".
 class InputError : public std::runtime_error {
-public:
+ public:
   using std::runtime_error::runtime_error;
 };
 

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <string>
 #include <vector>
 
 namespace covrast {
@@ -16,9 +17,7 @@ struct Image {
   int height = 0;
   std::vector<std::uint8_t> rgb;
   std::uint8_t* pixel(int x, int y) { return &rgb[(std::size_t(y) * width + x) * 3]; }
-  const std::uint8_t* pixel(int x, int y) const {
-    return &rgb[(std::size_t(y) * width + x) * 3];
-  }
+  const std::uint8_t* pixel(int x, int y) const { return &rgb[(std::size_t(y) * width + x) * 3]; }
 };
 
 /// Window depth per pixel in [0, 1] (0 = near plane, 1 = far plane); background = 1.
@@ -28,9 +27,24 @@ struct DepthImage {
   std::vector<float> depth;
 };
 
+/// A text record of a PNG file (a tEXt chunk): a keyword of 1..79 printable ASCII characters
+/// and ASCII text (golden images record what rendered them this way).
+struct PngText {
+  std::string keyword;
+  std::string text;
+};
+
 /// Writes a PNG atomically: a temporary file beside the target, then rename, so that a
 /// failure never leaves a partial or overwritten file. Throws InputError naming the path.
-void write_png(const Image& image, const std::filesystem::path& path);
+/// `text` records go into tEXt chunks right after the header.
+void write_png(const Image& image, const std::filesystem::path& path,
+               const std::vector<PngText>& text = {});
+
+/// The PNG file write_png writes, in memory (for embedding, e.g. in an HTML report).
+std::vector<std::uint8_t> encode_png(const Image& image, const std::vector<PngText>& text = {});
+
+/// The tEXt records of a PNG file, in file order. Throws InputError when it is not a PNG.
+std::vector<PngText> read_png_text(const std::filesystem::path& path);
 
 /// Writes depth as 16-bit greyscale PNG (.png) or as a little-endian PFM (.pfm), atomically.
 void write_depth(const DepthImage& depth, const std::filesystem::path& path);

@@ -105,4 +105,14 @@ class Renderer {
 /// One frame, convenience.
 RenderResult render(const Scene& scene, const RenderOptions& options);
 
+/// What this build of covrast is and runs on: what golden images record and test reports
+/// print, so that a mismatch says what rendered each side.
+struct BuildInfo {
+  std::string version;      ///< covrast's version (project() in CMakeLists.txt)
+  std::string compiler;     ///< e.g. "g++ 12.2.0"
+  std::string simd_target;  ///< the Highway target the kernels run on, e.g. "AVX3"
+  std::string cpu;          ///< the processor's model name
+};
+BuildInfo build_info();
+
 }  // namespace covrast

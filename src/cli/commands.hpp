@@ -8,6 +8,7 @@
 #include <optional>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 namespace covrast::cli {
@@ -46,20 +47,51 @@ struct CompareArgs {
   std::optional<double> max_pixels;
 };
 
+struct TestArgs {
+  std::string manifest;
+  std::string junit;      ///< empty: no JUnit XML
+  std::string report;     ///< empty: no HTML report
+  std::string artifacts;  ///< empty: no artifact images
+  bool json = false;
+  bool update = false;
+  bool all = false;
+  std::string shard;  ///< "I/N", empty: everything
+  int shard_index = 1, shard_count = 1;
+  std::string filter;  ///< glob on case names, empty: all
+  int threads = 0;
+  bool strict = false;
+  bool quiet = false;
+};
+
 CLI::App* add_render_command(CLI::App& app, RenderArgs& args);
 CLI::App* add_info_command(CLI::App& app, InfoArgs& args);
 CLI::App* add_compare_command(CLI::App& app, CompareArgs& args);
+CLI::App* add_test_command(CLI::App& app, TestArgs& args);
 
 /// Each returns the process exit code; InputError and other exceptions propagate to main.
 int run_render(const RenderArgs& args);
 int run_info(const InfoArgs& args);
 int run_compare(const CompareArgs& args);
+int run_test(TestArgs args);
 
 /// Throws InputError unless `path` could be created or replaced: its directory exists, is a
 /// directory and is writable, the path is not a directory, and its extension (lower case) is
 /// one of `extensions`. Run before any expensive work, so a bad output path fails fast.
 void check_output_path(const std::filesystem::path& path,
                        const std::vector<std::string_view>& extensions);
+
+/// Parses an image size "WxH" (decimal, each side 1..kMaxImageSide). Throws InputError.
+std::pair<int, int> parse_size(const std::string& text);
+
+/// Parses a shard "I/N" (1 <= I <= N <= 10000). Throws InputError.
+std::pair<int, int> parse_shard(const std::string& text);
+
+/// A case or scene name as a file name: letters, digits, '-', '_' and '.' kept, anything
+/// else '_' (never empty, never "." or "..").
+std::string safe_file_name(const std::string& name);
+
+/// Writes a text file atomically (a temporary file beside it, then rename). Throws InputError.
+void write_text_file(const std::filesystem::path& path, const std::string& text);
 
 /// Compact decimal form of a double for human-readable output ("%.6g"; "inf" for infinity).
 std::string format_number(double value);

@@ -34,22 +34,25 @@ void print_error(const std::string& message) {
 int main(int argc, char** argv) {
   CLI::App app{
       "covrast: a tiled, multithreaded CPU software rasterizer with exact analytic "
-      "anti-aliasing. Renders JSON scenes of OBJ/glTF meshes to PNG, inspects scenes and "
-      "compares images.",
+      "anti-aliasing. Renders JSON scenes of OBJ/glTF meshes to PNG, inspects scenes, "
+      "compares images and runs golden-image test manifests.",
       "covrast"};
   app.set_version_flag("--version", std::string("covrast ") + covrast::cli::kVersion,
                        "Print the version and exit");
   app.require_subcommand(1);
   app.footer(
-      "Exit codes: 0 success, 1 internal error or compare threshold exceeded, 2 bad input or "
+      "Exit codes: 0 success, 1 internal error, compare threshold exceeded or test failed, 2 bad "
+      "input or "
       "usage.\nRun 'covrast SUBCOMMAND --help' for the options of a subcommand.");
 
   covrast::cli::RenderArgs render_args;
   covrast::cli::InfoArgs info_args;
   covrast::cli::CompareArgs compare_args;
+  covrast::cli::TestArgs test_args;
   CLI::App* render = covrast::cli::add_render_command(app, render_args);
   CLI::App* info = covrast::cli::add_info_command(app, info_args);
   CLI::App* compare = covrast::cli::add_compare_command(app, compare_args);
+  CLI::App* test = covrast::cli::add_test_command(app, test_args);
 
   try {
     app.parse(argc, argv);
@@ -58,9 +61,9 @@ int main(int argc, char** argv) {
     // CLI11 reports an unknown command word only as "A subcommand is required".
     const std::string first = argc > 1 ? argv[1] : "";
     if (!first.empty() && first[0] != '-' && first != "render" && first != "info" &&
-        first != "compare") {
+        first != "compare" && first != "test") {
       print_error("unknown command '" + first +
-                  "' (expected render, info or compare; run 'covrast --help' for usage)");
+                  "' (expected render, info, compare or test; run 'covrast --help' for usage)");
       return 2;
     }
     print_error(std::string(e.what()) + " (run 'covrast --help' for usage)");
@@ -71,6 +74,7 @@ int main(int argc, char** argv) {
     if (render->parsed()) return covrast::cli::run_render(render_args);
     if (info->parsed()) return covrast::cli::run_info(info_args);
     if (compare->parsed()) return covrast::cli::run_compare(compare_args);
+    if (test->parsed()) return covrast::cli::run_test(test_args);
     print_error("no subcommand given (run 'covrast --help' for usage)");
     return 2;
   } catch (const covrast::InputError& e) {

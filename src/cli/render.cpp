@@ -27,24 +27,6 @@ namespace {
 constexpr int kMaxThreads = 4096;
 constexpr int kMaxRepeat = 1000;
 
-/// Parses "WxH" (decimal, each side 1..kMaxImageSide).
-std::pair<int, int> parse_size(const std::string& text) {
-  const auto fail = [&]() -> std::pair<int, int> {
-    throw InputError("--size: expected WxH with each side in 1.." + std::to_string(kMaxImageSide) +
-                     ", got '" + text + "'");
-  };
-  const std::size_t x = text.find_first_of("xX");
-  if (x == std::string::npos || x == 0 || x + 1 == text.size()) return fail();
-  const auto parse_side = [&](const char* first, const char* last) {
-    int value = 0;
-    const auto [end, error] = std::from_chars(first, last, value);
-    if (error != std::errc() || end != last || value < 1 || value > kMaxImageSide) fail();
-    return value;
-  };
-  const char* begin = text.data();
-  return {parse_side(begin, begin + x), parse_side(begin + x + 1, begin + text.size())};
-}
-
 /// Median of the per-frame values of one timing field; mean of the middle two for even K.
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
@@ -149,7 +131,13 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
 int run_render(const RenderArgs& args) {
   RenderOptions options;
   options.mode = parse_render_mode(args.mode);
-  if (!args.size.empty()) std::tie(options.width, options.height) = parse_size(args.size);
+  if (!args.size.empty()) {
+    try {
+      std::tie(options.width, options.height) = parse_size(args.size);
+    } catch (const InputError& e) {
+      throw InputError(std::string("--size: ") + e.what());
+    }
+  }
   options.threads = args.threads;
   options.tile = args.tile;
   options.want_depth = !args.depth.empty();

@@ -2,14 +2,18 @@
 #include "commands.hpp"
 
 #include <covrast/error.hpp>
+#include <covrast/scene.hpp>
 
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <string>
 #include <system_error>
 
 namespace covrast::cli {
@@ -47,6 +51,72 @@ void check_output_path(const std::filesystem::path& path,
   }
   if (fs::is_directory(fs::status(path, ec))) {
     throw InputError(shown + ": cannot write: is a directory");
+  }
+}
+
+/// Parses "WxH" (decimal, each side 1..kMaxImageSide).
+std::pair<int, int> parse_size(const std::string& text) {
+  const auto fail = [&]() -> std::pair<int, int> {
+    throw InputError("expected WxH with each side in 1.." + std::to_string(kMaxImageSide) +
+                     ", got '" + text + "'");
+  };
+  const std::size_t x = text.find_first_of("xX");
+  if (x == std::string::npos || x == 0 || x + 1 == text.size()) return fail();
+  const auto parse_side = [&](const char* first, const char* last) {
+    int value = 0;
+    const auto [end, error] = std::from_chars(first, last, value);
+    if (error != std::errc() || end != last || value < 1 || value > kMaxImageSide) fail();
+    return value;
+  };
+  const char* begin = text.data();
+  return {parse_side(begin, begin + x), parse_side(begin + x + 1, begin + text.size())};
+}
+
+std::pair<int, int> parse_shard(const std::string& text) {
+  const auto fail = [&]() -> std::pair<int, int> {
+    throw InputError("--shard: expected I/N with 1 <= I <= N <= 10000, got '" + text + "'");
+  };
+  const std::size_t slash = text.find('/');
+  if (slash == std::string::npos) return fail();
+  int index = 0, count = 0;
+  const char* begin = text.data();
+  const char* end = begin + text.size();
+  const auto a = std::from_chars(begin, begin + slash, index);
+  const auto b = std::from_chars(begin + slash + 1, end, count);
+  if (a.ec != std::errc() || a.ptr != begin + slash || b.ec != std::errc() || b.ptr != end ||
+      index < 1 || count < index || count > 10000) {
+    return fail();
+  }
+  return {index, count};
+}
+
+std::string safe_file_name(const std::string& name) {
+  std::string out;
+  for (const unsigned char c : name) {
+    out += std::isalnum(c) || c == '-' || c == '_' || c == '.' ? char(c) : '_';
+  }
+  if (out.empty() || out == "." || out == "..") out = "_" + out;
+  return out;
+}
+
+void write_text_file(const std::filesystem::path& path, const std::string& text) {
+  std::filesystem::path temp = path;
+  temp += ".tmp-" + std::to_string(::getpid());
+  {
+    std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+    out << text;
+    out.close();
+    if (!out) {
+      std::error_code ec;
+      std::filesystem::remove(temp, ec);
+      throw InputError(path.string() + ": cannot write");
+    }
+  }
+  std::error_code ec;
+  std::filesystem::rename(temp, path, ec);
+  if (ec) {
+    std::filesystem::remove(temp, ec);
+    throw InputError(path.string() + ": cannot write: " + ec.message());
   }
 }
 

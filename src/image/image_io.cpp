@@ -226,8 +226,27 @@ std::string lower_extension(const std::filesystem::path& path) {
 
 }  // namespace
 
-void write_png(const Image& image, const std::filesystem::path& path) {
-  check_image_shape(image.width, image.height, image.rgb.size(), 3, path);
+namespace {
+
+/// Bytes of the PNG signature and the IHDR chunk (4 length + 4 type + 13 data + 4 CRC): the
+/// text chunks go right after them.
+constexpr std::size_t kPngHeaderBytes = 8 + 25;
+
+void check_png_text(const PngText& record) {
+  const auto printable = [](unsigned char c) { return c >= 0x20 && c < 0x7f; };
+  if (record.keyword.empty() || record.keyword.size() > 79 ||
+      !std::all_of(record.keyword.begin(), record.keyword.end(), printable) ||
+      record.keyword.front() == ' ' || record.keyword.back() == ' ') {
+    throw std::invalid_argument("PNG text keyword '" + record.keyword +
+                                "' is not 1..79 printable ASCII characters");
+  }
+  if (!std::all_of(record.text.begin(), record.text.end(),
+                   [&](unsigned char c) { return printable(c) || c == '\n'; })) {
+    throw std::invalid_argument("PNG text of '" + record.keyword + "' is not printable ASCII");
+  }
+}
+
+Bytes encode_png_rgb8(const Image& image, const std::vector<PngText>& text) {
   Bytes png;
   const auto append = [](void* context, void* data, int size) {
     auto* out = static_cast<Bytes*>(context);
@@ -236,9 +255,66 @@ void write_png(const Image& image, const std::filesystem::path& path) {
   };
   if (stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(),
                              image.width * 3) == 0) {
-    throw std::runtime_error(path.string() + ": PNG encoding failed");
+    throw std::runtime_error("PNG encoding failed");
   }
-  write_atomically(path, png);
+  Bytes chunks;
+  for (const PngText& record : text) {
+    check_png_text(record);
+    Bytes data(record.keyword.begin(), record.keyword.end());
+    data.push_back(0);
+    data.insert(data.end(), record.text.begin(), record.text.end());
+    append_chunk(chunks, "tEXt", data.data(), data.size());
+  }
+  png.insert(png.begin() + kPngHeaderBytes, chunks.begin(), chunks.end());
+  return png;
+}
+
+std::uint32_t read_be32(const std::uint8_t* p) {
+  return std::uint32_t(p[0]) << 24 | std::uint32_t(p[1]) << 16 | std::uint32_t(p[2]) << 8 | p[3];
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> encode_png(const Image& image, const std::vector<PngText>& text) {
+  check_image_shape(image.width, image.height, image.rgb.size(), 3, "PNG");
+  return encode_png_rgb8(image, text);
+}
+
+void write_png(const Image& image, const std::filesystem::path& path,
+               const std::vector<PngText>& text) {
+  check_image_shape(image.width, image.height, image.rgb.size(), 3, path);
+  write_atomically(path, encode_png_rgb8(image, text));
+}
+
+std::vector<PngText> read_png_text(const std::filesystem::path& path) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    throw InputError(path.string() + ": cannot read PNG: " + errno_message(errno));
+  }
+  // Walk the chunks up to the first IDAT (text chunks that matter come before the pixels;
+  // reading no further keeps this cheap for large images).
+  std::vector<PngText> text;
+  std::uint8_t head[8] = {};
+  static constexpr std::uint8_t kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+  bool ok = std::fread(head, 1, 8, file) == 8 && std::memcmp(head, kSignature, 8) == 0;
+  constexpr std::uint32_t kMaxTextChunk = 1u << 20;
+  while (ok) {
+    if (std::fread(head, 1, 8, file) != 8) break;
+    const std::uint32_t length = read_be32(head);
+    const std::string type(reinterpret_cast<const char*>(head + 4), 4);
+    if (type == "IDAT" || type == "IEND") break;
+    if (type != "tEXt" || length > kMaxTextChunk) {
+      ok = std::fseek(file, long(length) + 4, SEEK_CUR) == 0;
+      continue;
+    }
+    std::string data(length, '\0');
+    ok = std::fread(data.data(), 1, length, file) == length && std::fseek(file, 4, SEEK_CUR) == 0;
+    const std::size_t nul = data.find('\0');
+    if (ok && nul != std::string::npos) text.push_back({data.substr(0, nul), data.substr(nul + 1)});
+  }
+  std::fclose(file);
+  if (!ok) throw InputError(path.string() + ": cannot read PNG text: not a PNG file or truncated");
+  return text;
 }
 
 void write_depth(const DepthImage& depth, const std::filesystem::path& path) {
