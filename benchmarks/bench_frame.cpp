@@ -301,8 +301,8 @@ void register_frame(const std::string& name, std::function<covrast::Scene()> mak
 
 void register_all(ContentSize size, const std::string& scenegen, const fs::path& real_dir) {
   std::vector<covrast::RenderMode> modes;
-  for (const char* text : {"aliased", "coverage", "coverage-blend", "msaa:4", "msaa:8", "msaa:16",
-                           "ssaa:2", "ssaa:4", "ssaa:8", "ssaa:16"}) {
+  for (const char* text : {"aliased", "fxaa", "coverage", "coverage-blend", "msaa:4", "msaa:8",
+                           "msaa:16", "ssaa:2", "ssaa:4", "ssaa:8", "ssaa:16"}) {
     covrast::RenderMode mode = covrast::parse_render_mode(text);
     if (mode_available(mode)) {
       modes.push_back(mode);
@@ -341,7 +341,8 @@ void register_all(ContentSize size, const std::string& scenegen, const fs::path&
     std::vector<covrast::RenderMode> picked;
     for (const covrast::RenderMode& mode : modes) {
       const std::string text = covrast::to_string(mode);
-      if (text == "aliased" || text == "coverage" || text == "coverage-blend" || text == "msaa:4") {
+      if (text == "aliased" || text == "fxaa" || text == "coverage" || text == "coverage-blend" ||
+          text == "msaa:4") {
         picked.push_back(mode);
       }
     }

@@ -302,7 +302,8 @@ TEST_CASE("cli: render of a good scene writes a PNG of the requested size", "[cl
   CHECK(stats.at("threads") == 2);
   CHECK(stats.at("frames") == 3);
   CHECK(stats.at("triangles").at("in") == 1);
-  for (const char* key : {"setup_ms", "binning_ms", "raster_ms", "resolve_ms", "render_ms"}) {
+  for (const char* key :
+       {"setup_ms", "binning_ms", "raster_ms", "resolve_ms", "post_ms", "render_ms"}) {
     INFO(key);
     CHECK(stats.at(key).get<double>() >= 0.0);
   }

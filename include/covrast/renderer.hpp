@@ -24,6 +24,7 @@ enum class ModeKind {
   SsaaCmj,        ///< N x N correlated multi-jittered (n-rooks) samples
   Msaa,           ///< K samples (D3D standard positions), shading once per pixel
   Reference,      ///< high-count supersampling in double precision: ground truth
+  Fxaa,           ///< aliased, then the FXAA 3.11 post-process (RenderOptions::fxaa)
 };
 
 struct RenderMode {
@@ -32,7 +33,7 @@ struct RenderMode {
 };
 
 /// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N",
-/// "msaa:K", "reference". Throws InputError listing the accepted forms.
+/// "msaa:K", "reference", "fxaa". Throws InputError listing the accepted forms.
 RenderMode parse_render_mode(std::string_view text);
 std::string to_string(const RenderMode& mode);
 
@@ -47,6 +48,22 @@ constexpr bool valid_tile_px(int tile_px) {
 /// The accepted tile sides in words, for messages and help texts.
 std::string tile_px_rule();
 
+/// The tuning knobs of FXAA 3.11's quality variant (docs/fxaa.md), with its defaults. Luma is
+/// dot((r, g, b), (0.299, 0.587, 0.114)) of the 8-bit sRGB-encoded colour, in [0, 1].
+struct FxaaOptions {
+  /// Steps of the search along an edge: 10..15 (medium dither), 20..29 (less dither), 39
+  /// (no dither); the last digit grows with the cost. 12 is FXAA's default.
+  int quality_preset = 12;
+  /// A pixel is processed when the luma range of its 4-neighbour cross is at least
+  /// max(edge_threshold_min, edge_threshold * the largest luma of the cross) [luma].
+  float edge_threshold = 0.166f;
+  float edge_threshold_min = 0.0833f;
+  /// Share of the sub-pixel aliasing removal, 0 (off) .. 1 (softest) [blend weight].
+  float subpix = 0.75f;
+};
+/// True for the presets FxaaOptions::quality_preset accepts.
+bool valid_fxaa_preset(int quality_preset);
+
 struct RenderOptions {
   RenderMode mode;
   int width = 0;    ///< 0: the scene's width
@@ -58,6 +75,7 @@ struct RenderOptions {
   /// (eye outside the mesh, no vertex clipped by the near or far plane; see
   /// docs/architecture.md). false keeps every triangle, to debug or measure the effect.
   bool cull_hidden_backfaces = true;
+  FxaaOptions fxaa;  ///< used by ModeKind::Fxaa only
 };
 
 struct RenderStats {
@@ -74,6 +92,7 @@ struct RenderStats {
   double binning_ms = 0;
   double raster_ms = 0;   ///< tile raster including per-tile resolve
   double resolve_ms = 0;  ///< frame-level resolve (linear -> sRGB, copy-out)
+  double post_ms = 0;     ///< frame post-process (fxaa mode; 0 otherwise)
   double render_ms = 0;   ///< the whole frame, without scene loading or PNG encoding
   int threads = 0;
   int tile = 0;

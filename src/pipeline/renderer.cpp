@@ -3,6 +3,7 @@
 //   scene -> [setup: transform, clip, snap]  parallel over vertex blocks, then chunks
 //         -> [binning]                        parallel over chunks (counting sort per chunk)
 //         -> [raster + tile resolve]          parallel over tiles, per-thread scratch
+//         -> [post-process: fxaa mode only]   parallel over rows of the whole frame
 //         -> image
 //
 // Each phase is a parallel loop over a fixed decomposition (chunks of the global triangle
@@ -11,6 +12,7 @@
 #include "binning/tile_bins.hpp"
 #include "core/tile_raster.hpp"
 #include "geometry/frontend.hpp"
+#include "post/fxaa.hpp"
 #include "raster/rasterizers.hpp"
 
 #include <covrast/renderer.hpp>
@@ -34,9 +36,10 @@ RenderMode parse_render_mode(std::string_view text) {
   auto fail = [&]() -> RenderMode {
     throw InputError("unknown mode '" + std::string(text) +
                      "': expected aliased, coverage, coverage-blend, ssaa:N, ssaa-grid:N or "
-                     "ssaa-cmj:N (N = 1..16), msaa:K (K = 2, 4, 8, 16) or reference");
+                     "ssaa-cmj:N (N = 1..16), msaa:K (K = 2, 4, 8, 16), reference or fxaa");
   };
   if (text == "aliased") return {ModeKind::Aliased, 1};
+  if (text == "fxaa") return {ModeKind::Fxaa, 1};
   if (text == "coverage") return {ModeKind::Coverage, 1};
   if (text == "coverage-blend") return {ModeKind::CoverageBlend, 1};
   if (text == "reference") return {ModeKind::Reference, 64};
@@ -86,6 +89,8 @@ std::string to_string(const RenderMode& mode) {
       return "msaa:" + std::to_string(mode.samples);
     case ModeKind::Reference:
       return "reference";
+    case ModeKind::Fxaa:
+      return "fxaa";
   }
   return "?";
 }
@@ -105,7 +110,45 @@ double ms_between(Clock::time_point a, Clock::time_point b) {
 /// Vertices per transform task: whole blocks, as transform_vertices requires.
 constexpr std::size_t kVerticesPerBlock = detail::kVerticesPerTransformBlock;
 
+/// Rows per post-process task: enough work per task (a 1920-pixel row is ~2000 pixel
+/// tests) to hide the scheduling, small enough to balance 2..64 threads.
+constexpr int kPostRowsPerTask = 8;
+
+void check_fxaa_options(const FxaaOptions& fxaa) {
+  if (!valid_fxaa_preset(fxaa.quality_preset)) {
+    throw InputError("FXAA quality preset " + std::to_string(fxaa.quality_preset) +
+                     " unknown: expected 10..15, 20..29 or 39");
+  }
+  const auto in_unit = [](float v) { return v >= 0.0f && v <= 1.0f; };  // false for NaN
+  if (!in_unit(fxaa.edge_threshold) || !in_unit(fxaa.edge_threshold_min) || !in_unit(fxaa.subpix)) {
+    throw InputError("FXAA edge thresholds and subpix must each lie in [0, 1]");
+  }
+}
+
+/// FXAA over the finished frame: it reads a copy of the frame (the search along an edge
+/// reaches up to ~20 pixels away, across tiles), so each output pixel depends on the input
+/// only and any split over rows gives the same bytes. `input` and `luma` are per-frame
+/// memory kept by the Renderer. Call inside the arena.
+void post_process_fxaa(const FxaaOptions& options, Image& input, detail::LumaPlane& luma,
+                       Image& frame) {
+  input = frame;
+  luma.width = frame.width;
+  luma.height = frame.height;
+  luma.luma.resize(std::size_t(frame.width) * frame.height);
+  const auto rows = tbb::blocked_range<int>(0, frame.height, kPostRowsPerTask);
+  tbb::parallel_for(rows, [&](const tbb::blocked_range<int>& r) {
+    detail::fxaa_luma_rows(input, luma, r.begin(), r.end());
+  });
+  tbb::parallel_for(rows, [&](const tbb::blocked_range<int>& r) {
+    detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end());
+  });
+}
+
 }  // namespace
+
+bool valid_fxaa_preset(int quality_preset) {
+  return !detail::fxaa_search_steps(quality_preset).empty();
+}
 
 struct Renderer::Impl {
   const Scene& scene;
@@ -127,6 +170,8 @@ struct Renderer::Impl {
   tbb::enumerable_thread_specific<std::unique_ptr<detail::TileRasterizer>> rasterizers;
   tbb::enumerable_thread_specific<detail::SetupCounters> setup_counters;
   tbb::enumerable_thread_specific<double> resolve_thread_ms;
+  Image post_input;             ///< fxaa mode: the aliased frame the post-process reads
+  detail::LumaPlane post_luma;  ///< fxaa mode: its luma
 
   Impl(const Scene& s, const RenderOptions& o, int w, int h, int t)
       : scene(s),
@@ -161,6 +206,7 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
   int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   // Fail early on modes that cannot be built.
   detail::make_tile_rasterizer(options.mode, options.tile);
+  if (options.mode.kind == ModeKind::Fxaa) check_fxaa_options(options.fxaa);
   impl_ = std::make_unique<Impl>(scene, options, w, h, threads);
 }
 
@@ -184,7 +230,7 @@ RenderResult Renderer::render_frame() {
   for (const auto& r : im.rasterizers) overflows_before += r->overflow_count();
   for (auto& r : im.resolve_thread_ms) r = 0;
 
-  Clock::time_point t0, t1, t2, t3;
+  Clock::time_point t0, t1, t2, t3, t4;
   im.arena.execute([&] {
     t0 = Clock::now();
     // Setup, part 1: vertices to clip space, in fixed blocks per instance.
@@ -246,6 +292,10 @@ RenderResult Renderer::render_frame() {
           }
         });
     t3 = Clock::now();
+    if (im.options.mode.kind == ModeKind::Fxaa) {
+      post_process_fxaa(im.options.fxaa, im.post_input, im.post_luma, result.color);
+    }
+    t4 = Clock::now();
   });
 
   RenderStats& st = result.stats;
@@ -270,7 +320,8 @@ RenderResult Renderer::render_frame() {
   // per-thread resolve time spread over the threads that ran.
   st.resolve_ms = resolve_total / std::max(1, im.threads);
   st.raster_ms = std::max(0.0, ms_between(t2, t3) - st.resolve_ms);
-  st.render_ms = ms_between(t0, t3);
+  st.post_ms = ms_between(t3, t4);
+  st.render_ms = ms_between(t0, t4);
   st.threads = im.threads;
   st.tile = im.options.tile;
   return result;

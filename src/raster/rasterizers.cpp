@@ -8,6 +8,7 @@ namespace covrast::detail {
 std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int tile_px) {
   switch (mode.kind) {
     case ModeKind::Aliased:
+    case ModeKind::Fxaa:  // the pipeline runs FXAA on the finished aliased frame
       return make_aliased_rasterizer(tile_px);
     case ModeKind::Coverage:
       return make_coverage_rasterizer(tile_px, false);
