@@ -21,6 +21,7 @@
 #include <string>
 #include <vector>
 
+#include "test_cli_run.hpp"
 #include "test_tempdir.hpp"
 
 namespace fs = std::filesystem;
@@ -33,61 +34,13 @@ class TempDir : public covrast::test::TempDir {
   TempDir() : covrast::test::TempDir("covrast-test-cli") {}
 };
 
-void write_text(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-  REQUIRE(out.good());
-}
+using covrast::test::read_text;
+using covrast::test::RunResult;
+using covrast::test::write_text;
 
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-/// Single-quotes an argument for /bin/sh.
-std::string quoted(const std::string& arg) {
-  std::string out = "'";
-  for (char c : arg) {
-    if (c == '\'') {
-      out += "'\\''";
-    } else {
-      out += c;
-    }
-  }
-  return out + "'";
-}
-
-struct RunResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-/// Runs the CLI with `args`, capturing stdout and stderr in files inside `dir`.
+/// Runs the CLI with `args` in `dir`.
 RunResult run_cli(const TempDir& dir, std::initializer_list<std::string> args) {
-  const fs::path out_file = dir / "stdout.txt";
-  const fs::path err_file = dir / "stderr.txt";
-  std::string command = quoted(COVRAST_CLI_PATH);
-  // Appending piecewise (not `" " + quoted(...)`) also avoids a g++ 12 -Wrestrict false positive.
-  for (const std::string& arg : args) {
-    command += ' ';
-    command += quoted(arg);
-  }
-  command += " >";
-  command += quoted(out_file.string());
-  command += " 2>";
-  command += quoted(err_file.string());
-  command += " </dev/null";
-  const int status = std::system(command.c_str());
-  RunResult result;
-  REQUIRE(status != -1);
-  REQUIRE(WIFEXITED(status));
-  result.exit_code = WEXITSTATUS(status);
-  result.out = read_text(out_file);
-  result.err = read_text(err_file);
-  fs::remove(out_file);
-  fs::remove(err_file);
-  return result;
+  return covrast::test::run_cli_in(dir.path(), std::vector<std::string>(args));
 }
 
 /// An error must be exactly one line on stderr starting with "covrast: error: ".
