@@ -1060,6 +1060,38 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
   CHECK(targets.size() >= 1);
 }
 
+TEST_CASE("coverage modes: the scalar twin of the kernel renders the SIMD kernel's bytes",
+          "[coverage]") {
+  // test_coverage_kernel.cpp compares cover_group_scalar with cover_group_simd group by group;
+  // here the whole renderer runs on each, so that what the rasterizer makes of the rows (runs,
+  // aligned groups beside decided blocks, the A-buffer, the blend) is compared too.
+  covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
+  const Scene scenes[] = {default_like_scene(),
+                          sphere_scene(from_codes(230, 120, 40), from_codes(10, 20, 30))};
+  for (const Scene& s : scenes) {
+    for (const ModeKind mode : {ModeKind::Coverage, ModeKind::CoverageBlend}) {
+      for (int tile : {16, 64}) {
+        INFO("scene " << (&s - scenes) << ", mode " << covrast::to_string({mode, 1}) << ", tile "
+                      << tile);
+        RenderOptions o;
+        o.mode.kind = mode;
+        o.tile = tile;
+        o.threads = 2;
+        o.want_depth = true;
+        hooks.scalar_kernel = true;
+        const auto scalar = covrast::render(s, o);
+        hooks.scalar_kernel = false;
+        covrast::test::for_each_target([&](std::int64_t) {
+          const auto simd = covrast::render(s, o);
+          REQUIRE(simd.color.rgb.size() == scalar.color.rgb.size());
+          CHECK(simd.color.rgb == scalar.color.rgb);
+          CHECK(simd.depth.depth == scalar.depth.depth);
+        });
+      }
+    }
+  }
+}
+
 TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by-pixel adds give",
           "[coverage]") {
   // Large triangles (covering whole tiles and blocks) at nearby, tied and crossing depths,
