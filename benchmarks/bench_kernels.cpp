@@ -36,7 +36,7 @@
 // inputs and fails if any output differs.
 #include "binning/tile_bins.hpp"
 #include "core/edge_function.hpp"
-#include "core/simd_target.hpp"
+#include "core/testing_hooks.hpp"
 #include "geometry/frontend.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
 #include "raster/samples/sample_kernel.hpp"
@@ -124,8 +124,8 @@ constexpr std::size_t kStride = kColumnGroup * 2;
 /// and makes the fixed set of triangle groups it runs over.
 std::vector<KernelJob> start_kernel_run(benchmark::State& state, std::int64_t target, double min_px,
                                         double max_px) {
-  if (target != 0) force_simd_target(target);
-  state.SetLabel(target != 0 ? simd_target_name() : "scalar");
+  if (target != 0) testing::force_simd_target(target);
+  state.SetLabel(target != 0 ? testing::simd_target_name() : "scalar");
   return make_kernel_jobs(min_px, max_px, 1234);
 }
 
@@ -133,7 +133,7 @@ std::vector<KernelJob> start_kernel_run(benchmark::State& state, std::int64_t ta
 /// counters from what one iteration computed.
 void finish_kernel_run(benchmark::State& state, std::int64_t target, std::uint64_t columns,
                        std::uint64_t pixels) {
-  if (target != 0) force_simd_target(0);
+  if (target != 0) testing::force_simd_target(0);
   const double n = double(state.iterations());
   state.counters["columns/s"] =
       benchmark::Counter(n * double(columns), benchmark::Counter::kIsRate);
@@ -457,12 +457,12 @@ struct ForcedKernels {
   SampleKernels kernels;
   std::int64_t target;
   ForcedKernels(benchmark::State& state, std::int64_t t) : target(t) {
-    if (target != 0) force_simd_target(target);
+    if (target != 0) testing::force_simd_target(target);
     kernels = target != 0 ? sample_kernels_simd() : sample_kernels_scalar();
-    state.SetLabel(target != 0 ? simd_target_name() : "scalar");
+    state.SetLabel(target != 0 ? testing::simd_target_name() : "scalar");
   }
   ~ForcedKernels() {
-    if (target != 0) force_simd_target(0);
+    if (target != 0) testing::force_simd_target(0);
   }
   ForcedKernels(const ForcedKernels&) = delete;
   ForcedKernels& operator=(const ForcedKernels&) = delete;
@@ -766,7 +766,7 @@ void register_all() {
                                    run_kernel(state, coverage_rows_scalar, 0, s.min_px, s.max_px);
                                  })
         ->UseRealTime();
-    const std::int64_t usable = compiled_simd_targets() & hwy::SupportedTargets();
+    const std::int64_t usable = testing::compiled_simd_targets() & hwy::SupportedTargets();
     for (std::int64_t bits = usable; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
       benchmark::RegisterBenchmark(
@@ -784,7 +784,7 @@ void register_all() {
                                                    s.max_px);
                                  })
         ->UseRealTime();
-    const std::int64_t usable = compiled_simd_targets() & hwy::SupportedTargets();
+    const std::int64_t usable = testing::compiled_simd_targets() & hwy::SupportedTargets();
     for (std::int64_t bits = usable; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
       benchmark::RegisterBenchmark(
@@ -799,7 +799,7 @@ void register_all() {
 
   // Sample-mode kernels: scalar, then every Highway target compiled in and supported.
   std::vector<std::pair<std::string, std::int64_t>> impls = {{"scalar", 0}};
-  const std::int64_t sample_usable = compiled_simd_targets() & hwy::SupportedTargets();
+  const std::int64_t sample_usable = testing::compiled_simd_targets() & hwy::SupportedTargets();
   for (std::int64_t bits = sample_usable; bits != 0; bits &= bits - 1) {
     const std::int64_t target = bits & -bits;
     impls.emplace_back("simd:" + std::string(hwy::TargetName(target)), target);

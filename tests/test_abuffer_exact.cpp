@@ -1,10 +1,10 @@
 // Coverage mode, exact by construction: the A-buffer adds exact areas only where fragments
 // provably do not overlap, and its fast paths give what the per-sample list resolve gives.
+#include "core/testing_hooks.hpp"
 #include "core/tile_raster.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/coverage/abuffer.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
-#include "raster/rasterizers.hpp"
 
 #include <covrast/compare.hpp>
 #include <covrast/renderer.hpp>
@@ -184,11 +184,12 @@ struct BothResolves {
 };
 BothResolves both_resolves(const Scene& s, bool cull = true) {
   BothResolves r{render(s, ModeKind::Coverage, cull), {}};
-  covrast::detail::force_abuffer_mask_resolve(true);
-  covrast::detail::force_coverage_pixel_path(true);
+  covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
+  hooks.mask_resolve = true;
+  hooks.pixel_path_only = true;
   r.masks = render(s, ModeKind::Coverage, cull);
-  covrast::detail::force_abuffer_mask_resolve(false);
-  covrast::detail::force_coverage_pixel_path(false);
+  hooks.mask_resolve = false;
+  hooks.pixel_path_only = false;
   return r;
 }
 

@@ -568,16 +568,16 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
     CHECK(m.rows == 0);
   }
   for (std::int64_t target : targets) {
-    covrast::detail::force_simd_target(target);
+    covrast::detail::testing::force_simd_target(target);
     INFO("target " << hwy::TargetName(target));
-    CHECK(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
+    CHECK(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     const Mismatch m = compare({Path::KernelAllRows, Path::KernelLikeDraw, Path::Fused});
     INFO(m.first);
     CHECK(m.pixels == 0);
     CHECK(m.beyond == 0);
     CHECK(m.rows == 0);
   }
-  covrast::detail::force_simd_target(0);
+  covrast::detail::testing::force_simd_target(0);
   CHECK(hwy::SupportedTargets() == supported);
 }
 
@@ -635,7 +635,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
     covrast::detail::coverage_rows_scalar(*cols, col, row_begin, row_begin + kRows, sign,
                                           scalar.data(), kColumnGroup);
     for (std::int64_t target : targets) {
-      covrast::detail::force_simd_target(target);
+      covrast::detail::testing::force_simd_target(target);
       std::fill(simd.begin(), simd.end(), kPoison);
       covrast::detail::coverage_rows_simd(*cols, col, row_begin, row_begin + kRows, sign,
                                           simd.data(), kColumnGroup);
@@ -659,7 +659,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
       }
     }
   }
-  covrast::detail::force_simd_target(0);
+  covrast::detail::testing::force_simd_target(0);
   INFO(first);
   CHECK(compared == 3000u * targets.size() * kRows * kColumnGroup);
   CHECK(differing == 0);

@@ -6,10 +6,10 @@
 //
 // Scenes are built in code. The camera looks down -z from (0, 0, 10); world_at() places a
 // vertex at a chosen pixel position and depth, so the screen geometry is known.
+#include "core/testing_hooks.hpp"
 #include "core/triangle_setup.hpp"
 #include "geometry/frontend.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
-#include "raster/rasterizers.hpp"
 
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -366,8 +366,10 @@ namespace {
 /// A-buffers made while it lives keep at most `fragments` per pixel, so that small scenes
 /// reach the overflow policy (the product's limit, kMaxFragmentsPerPixel, is larger).
 struct FragmentCapacity {
-  explicit FragmentCapacity(int fragments) { covrast::detail::force_abuffer_capacity(fragments); }
-  ~FragmentCapacity() { covrast::detail::force_abuffer_capacity(0); }
+  explicit FragmentCapacity(int fragments) {
+    covrast::detail::testing::coverage_hooks.fragment_capacity = fragments;
+  }
+  ~FragmentCapacity() { covrast::detail::testing::coverage_hooks.fragment_capacity = 0; }
   FragmentCapacity(const FragmentCapacity&) = delete;
   FragmentCapacity& operator=(const FragmentCapacity&) = delete;
 };
@@ -1041,7 +1043,7 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
   std::string names;
   for (std::int64_t target : targets) {
     names += std::string(hwy::TargetName(target)) + " ";
-    covrast::detail::force_simd_target(target);
+    covrast::detail::testing::force_simd_target(target);
     for (int threads : {1, 2}) {
       for (int tile : {8, 16, 64, 256}) {
         INFO("target " << hwy::TargetName(target) << ", threads " << threads << ", tile " << tile);
@@ -1052,10 +1054,42 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
       }
     }
   }
-  covrast::detail::force_simd_target(0);
+  covrast::detail::testing::force_simd_target(0);
   WARN("determinism (coverage and aliased) checked on targets: "
        << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
   CHECK(targets.size() >= 1);
+}
+
+TEST_CASE("coverage modes: the scalar twin of the kernel renders the SIMD kernel's bytes",
+          "[coverage]") {
+  // test_coverage_kernel.cpp compares cover_group_scalar with cover_group_simd group by group;
+  // here the whole renderer runs on each, so that what the rasterizer makes of the rows (runs,
+  // aligned groups beside decided blocks, the A-buffer, the blend) is compared too.
+  covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
+  const Scene scenes[] = {default_like_scene(),
+                          sphere_scene(from_codes(230, 120, 40), from_codes(10, 20, 30))};
+  for (const Scene& s : scenes) {
+    for (const ModeKind mode : {ModeKind::Coverage, ModeKind::CoverageBlend}) {
+      for (int tile : {16, 64}) {
+        INFO("scene " << (&s - scenes) << ", mode " << covrast::to_string({mode, 1}) << ", tile "
+                      << tile);
+        RenderOptions o;
+        o.mode.kind = mode;
+        o.tile = tile;
+        o.threads = 2;
+        o.want_depth = true;
+        hooks.scalar_kernel = true;
+        const auto scalar = covrast::render(s, o);
+        hooks.scalar_kernel = false;
+        covrast::test::for_each_target([&](std::int64_t) {
+          const auto simd = covrast::render(s, o);
+          REQUIRE(simd.color.rgb.size() == scalar.color.rgb.size());
+          CHECK(simd.color.rgb == scalar.color.rgb);
+          CHECK(simd.depth.depth == scalar.depth.depth);
+        });
+      }
+    }
+  }
 }
 
 TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by-pixel adds give",
@@ -1096,9 +1130,9 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
       o.threads = 2;
       o.want_depth = true;
       const auto fast = covrast::render(s, o);
-      covrast::detail::force_coverage_pixel_path(true);
+      covrast::detail::testing::coverage_hooks.pixel_path_only = true;
       const auto slow = covrast::render(s, o);
-      covrast::detail::force_coverage_pixel_path(false);
+      covrast::detail::testing::coverage_hooks.pixel_path_only = false;
       REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
       CHECK(fast.color.rgb == slow.color.rgb);
       CHECK(fast.depth.depth == slow.depth.depth);
@@ -1121,15 +1155,18 @@ TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from th
     s.meshes.back().model = glm::dmat4(glm::dvec4(p[3], 0, 0, 0), glm::dvec4(0, p[3], 0, 0),
                                        glm::dvec4(0, 0, p[3], 0), glm::dvec4(p[0], p[1], p[2], 1));
   }
+  covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
   for (int tile : {16, 64}) {
     INFO("tile " << tile);
-    const std::uint64_t before = covrast::detail::abuffer_layer_resolves();
+    hooks.count_layer_resolves = true;
+    hooks.layer_resolves = 0;
     const Image with_sums = render(s, ModeKind::Coverage, 2, tile).color;
-    const std::uint64_t used = covrast::detail::abuffer_layer_resolves() - before;
-    covrast::detail::force_abuffer_list_resolve(true);
+    const std::uint64_t used = hooks.layer_resolves.exchange(0);
+    hooks.list_resolve = true;
     const Image lists_only = render(s, ModeKind::Coverage, 2, tile).color;
-    const std::uint64_t used_forced = covrast::detail::abuffer_layer_resolves() - before - used;
-    covrast::detail::force_abuffer_list_resolve(false);
+    const std::uint64_t used_forced = hooks.layer_resolves.load();
+    hooks.list_resolve = false;
+    hooks.count_layer_resolves = false;
     CHECK(used > 1000);       // the sums resolved many pixels...
     CHECK(used_forced == 0);  // ...and none when forced off
     REQUIRE(with_sums.rgb.size() == lists_only.rgb.size());

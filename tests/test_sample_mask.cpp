@@ -26,7 +26,6 @@
 
 namespace {
 
-using covrast::detail::force_simd_target;
 using covrast::detail::kMaskSamples;
 using covrast::detail::kMaskSampleX_fx9;
 using covrast::detail::kMaskSampleY_fx9;
@@ -36,6 +35,7 @@ using covrast::detail::pixel_sample_mask_scalar;
 using covrast::detail::SampleMask;
 using covrast::detail::TriangleEdges;
 using covrast::detail::TriangleSetup;
+using covrast::detail::testing::force_simd_target;
 
 using MaskFn = SampleMask (*)(const TriangleSetup&, int, int);
 
@@ -120,13 +120,12 @@ std::string describe(const TriangleSetup& t, int x, int y) {
 /// Runs `check(name, fn)` with the scalar reference and with pixel_sample_mask forced to
 /// each usable target in turn; restores the best target afterwards.
 void for_each_implementation(const std::function<void(const std::string&, MaskFn)>& check) {
-  const std::vector<std::int64_t> targets =
-      covrast::test::usable_targets();
+  const std::vector<std::int64_t> targets = covrast::test::usable_targets();
   REQUIRE(!targets.empty());
   check("scalar", pixel_sample_mask_scalar);
   for (std::int64_t target : targets) {
     force_simd_target(target);
-    REQUIRE(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
+    REQUIRE(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     check(hwy::TargetName(target), pixel_sample_mask);
   }
   force_simd_target(0);

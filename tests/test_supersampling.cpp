@@ -4,8 +4,8 @@
 // Most tests drive the tile rasterizers directly with screen triangles built here from
 // 24.8 fixed-point vertices, so the geometry is known exactly and the resolved linear
 // colours can be read before 8-bit encoding; the scene tests go through covrast::render.
-#include "core/simd_target.hpp"
 #include "core/srgb8.hpp"
+#include "core/testing_hooks.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/rasterizers.hpp"
 #include "raster/reference/reference.hpp"
@@ -881,7 +881,8 @@ TEST_CASE(
     "[ssaa]") {
   const Scene scene = determinism_scene(97, 61);
   const Scene small = determinism_scene(41, 27);
-  const std::int64_t targets = covrast::detail::compiled_simd_targets() & hwy::SupportedTargets();
+  const std::int64_t targets =
+      covrast::detail::testing::compiled_simd_targets() & hwy::SupportedTargets();
   int forced = 0;
   for (const char* mode : {"ssaa:1", "ssaa:2", "ssaa:3", "ssaa:4", "ssaa:16", "ssaa-grid:5",
                            "ssaa-cmj:1", "ssaa-cmj:2", "ssaa-cmj:3", "ssaa-cmj:4", "ssaa-cmj:16",
@@ -900,10 +901,10 @@ TEST_CASE(
     if (reference) continue;  // no SIMD kernels in the reference mode
     for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
-      covrast::detail::force_simd_target(target);
+      covrast::detail::testing::force_simd_target(target);
       INFO("target " << hwy::TargetName(target));
       const Image img = render_mode(s, mode, 2, 64).color;
-      covrast::detail::force_simd_target(0);
+      covrast::detail::testing::force_simd_target(0);
       REQUIRE(img.rgb == base.rgb);
       ++forced;
     }
@@ -917,10 +918,10 @@ TEST_CASE(
   // Forcing really switches the kernels: one distinct function per target.
   std::vector<covrast::detail::SampleGroupFn> kernels;
   for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
-    covrast::detail::force_simd_target(bits & -bits);
+    covrast::detail::testing::force_simd_target(bits & -bits);
     kernels.push_back(covrast::detail::sample_kernels_simd().sample);
   }
-  covrast::detail::force_simd_target(0);
+  covrast::detail::testing::force_simd_target(0);
   std::sort(kernels.begin(), kernels.end(), std::less<covrast::detail::SampleGroupFn>());
   REQUIRE(std::unique(kernels.begin(), kernels.end()) - kernels.begin() ==
           std::ptrdiff_t(kernels.size()));

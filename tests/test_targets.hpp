@@ -2,7 +2,7 @@
 // that runs a check once per target with the target's name on every failure.
 #pragma once
 
-#include "core/simd_target.hpp"
+#include "core/testing_hooks.hpp"
 
 #include <hwy/targets.h>
 
@@ -18,7 +18,8 @@ namespace covrast::test {
 /// target: hwy::SupportedTargets() reports the mock once one is set.
 inline std::vector<std::int64_t> usable_targets() {
   std::vector<std::int64_t> targets;
-  const std::int64_t usable = covrast::detail::compiled_simd_targets() & hwy::SupportedTargets();
+  const std::int64_t usable =
+      covrast::detail::testing::compiled_simd_targets() & hwy::SupportedTargets();
   for (std::int64_t bits = usable; bits != 0; bits &= bits - 1) targets.push_back(bits & -bits);
   return targets;
 }
@@ -29,12 +30,12 @@ template <class Check>
 void for_each_target(Check check) {
   const std::int64_t supported = hwy::SupportedTargets();
   for (const std::int64_t target : usable_targets()) {
-    covrast::detail::force_simd_target(target);
+    covrast::detail::testing::force_simd_target(target);
     INFO("SIMD target " << hwy::TargetName(target));
-    REQUIRE(std::string(covrast::detail::simd_target_name()) == hwy::TargetName(target));
+    REQUIRE(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     check(target);
   }
-  covrast::detail::force_simd_target(0);
+  covrast::detail::testing::force_simd_target(0);
   CHECK(hwy::SupportedTargets() == supported);
 }
 

@@ -2,8 +2,8 @@
 // images record and that test reports print, so that a mismatch says what rendered each side.
 #include <covrast/renderer.hpp>
 
-#include "core/simd_target.hpp"
-
+#include <hwy/highway.h>
+#include <hwy/targets.h>
 #include <sys/utsname.h>
 
 #include <fstream>
@@ -38,6 +38,13 @@ std::string cpu_name() {
   return uname(&machine) == 0 ? std::string(machine.machine) : "unknown CPU";
 }
 
+/// The target the kernels dispatch to: the best one both compiled (HWY_TARGETS, the same in
+/// every source of the library) and supported by this CPU, the lowest bit.
+const char* simd_target() {
+  const std::int64_t usable = HWY_TARGETS & hwy::SupportedTargets();
+  return hwy::TargetName(usable & -usable);
+}
+
 std::string trimmed(std::string text) {
   while (!text.empty() && text.back() == ' ') text.pop_back();
   return text;
@@ -49,7 +56,7 @@ BuildInfo build_info() {
   BuildInfo info;
   info.version = COVRAST_VERSION;
   info.compiler = trimmed(compiler_name());
-  info.simd_target = detail::simd_target_name();
+  info.simd_target = simd_target();
   info.cpu = trimmed(cpu_name());
   return info;
 }

@@ -189,7 +189,144 @@ struct Renderer::Impl {
     chunk_bounds.resize(front_end.chunk_count());
     chunk_bins.resize(front_end.chunk_count());
   }
+
+  /// The frame's image, all zeros, and its depth (1 = far) when the options ask for it.
+  RenderResult blank_result() const;
+  /// Zeroes the per-frame counters; returns the rasterizers' overflow count so far (it runs
+  /// over the Renderer's life).
+  std::uint64_t begin_frame_counters();
+  /// Setup, part 1: vertices to clip space, in fixed blocks per instance; part 2: clip,
+  /// snap and set up each chunk of triangles.
+  void set_up_triangles();
+  /// Each chunk bins its own triangles.
+  void bin_triangles();
+  /// Raster and resolve, one task per range of tiles, each tile drawn from start to end by
+  /// one worker's rasterizer.
+  void raster_tiles(const detail::FrameTarget& target);
+  /// One tile: its triangles in submission order (chunk by chunk), then the resolve.
+  void raster_tile(detail::TileRasterizer& raster, int tile, const detail::FrameTarget& target);
+  /// When each stage of a frame began, and when the frame ended.
+  struct StageTimes {
+    Clock::time_point setup, binning, raster, post, end;
+  };
+  /// The counters and stage times of a frame.
+  void fill_stats(RenderStats& st, std::uint64_t overflows_before, const StageTimes& t) const;
 };
+
+RenderResult Renderer::Impl::blank_result() const {
+  RenderResult result;
+  result.color.width = width_px;
+  result.color.height = height_px;
+  result.color.rgb.assign(std::size_t(width_px) * height_px * 3, 0);
+  if (options.want_depth) {
+    result.depth.width = width_px;
+    result.depth.height = height_px;
+    result.depth.depth.assign(std::size_t(width_px) * height_px, 1.0f);
+  }
+  return result;
+}
+
+std::uint64_t Renderer::Impl::begin_frame_counters() {
+  for (auto& c : setup_counters) c = {};
+  std::uint64_t overflows_before = 0;
+  for (const auto& r : rasterizers) overflows_before += r->overflow_count();
+  for (auto& r : resolve_thread_ms) r = 0;
+  return overflows_before;
+}
+
+void Renderer::Impl::set_up_triangles() {
+  std::vector<std::pair<std::size_t, std::size_t>> blocks;
+  for (std::size_t i = 0; i < front_end.instance_count(); ++i) {
+    for (std::size_t v = 0; v < front_end.vertex_count(i); v += kVerticesPerBlock) {
+      blocks.emplace_back(i, v);
+    }
+  }
+  tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
+    auto [instance, begin] = blocks[b];
+    std::size_t end = std::min(begin + kVerticesPerBlock, front_end.vertex_count(instance));
+    front_end.transform_vertices(instance, begin, end);
+  });
+  tbb::parallel_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
+    // Room for one output per input in the chunk's slice (clipping can add more, and then
+    // the chunk moves to its own array).
+    chunk_triangles[c].reset(static_cast<TriangleSetup*>(setup_storage.data()) +
+                                 std::size_t(c) * detail::kTrianglesPerChunk,
+                             front_end.chunk_triangle_count(c));
+    chunk_bounds[c].clear();
+    chunk_bounds[c].reserve(front_end.chunk_triangle_count(c));
+    front_end.setup_chunk(c, chunk_triangles[c], chunk_bounds[c], setup_counters.local());
+  });
+}
+
+void Renderer::Impl::bin_triangles() {
+  tbb::parallel_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
+    detail::bin_chunk(grid, chunk_bounds[c], chunk_bins[c], bin_scratch.local());
+  });
+}
+
+void Renderer::Impl::raster_tiles(const detail::FrameTarget& target) {
+  tbb::parallel_for(tbb::blocked_range<int>(0, grid.tile_count(), 1),
+                    [&](const tbb::blocked_range<int>& r) {
+                      detail::TileRasterizer& raster = *rasterizers.local();
+                      for (int tile = r.begin(); tile < r.end(); ++tile) {
+                        raster_tile(raster, tile, target);
+                      }
+                    });
+}
+
+void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
+                                 const detail::FrameTarget& target) {
+  raster.begin_tile(grid.tile_rect(tile), target);
+  for (std::size_t c = 0; c < chunk_bins.size(); ++c) {
+    const auto& tris = chunk_triangles[c];
+    const std::span<const std::uint32_t> list = chunk_bins[c].tile(tile);
+    for (std::size_t k = 0; k < list.size(); ++k) {
+      // The tile's triangles are scattered through the chunk: fetch the set-up (two cache
+      // lines) a few triangles ahead.
+      if (k + kPrefetchAhead < list.size()) {
+        const char* ahead = reinterpret_cast<const char*>(&tris[list[k + kPrefetchAhead]]);
+        __builtin_prefetch(ahead);
+        __builtin_prefetch(ahead + 64);
+      }
+      raster.draw(tris[list[k]]);
+    }
+  }
+  // end_tile resolves; banded modes also rasterise there, and that part counts as raster.
+  const double deferred = raster.deferred_raster_ms();
+  Clock::time_point r0 = Clock::now();
+  raster.end_tile(target);
+  resolve_thread_ms.local() +=
+      ms_between(r0, Clock::now()) - (raster.deferred_raster_ms() - deferred);
+}
+
+void Renderer::Impl::fill_stats(RenderStats& st, std::uint64_t overflows_before,
+                                const StageTimes& t) const {
+  st.triangles_in = front_end.triangle_count();
+  for (const auto& c : setup_counters) {
+    st.triangles_culled += c.culled;
+    st.triangles_clipped += c.clipped;
+    st.triangles_backface_culled += c.backface_culled;
+  }
+  for (const auto& tris : chunk_triangles) st.triangles_setup += tris.size();
+  for (const auto& b : chunk_bins) st.bin_entries += b.triangle_index.size();
+  double resolve_total = 0;
+  for (double r : resolve_thread_ms) resolve_total += r;
+  for (const auto& r : rasterizers) {
+    st.scratch_bytes += r->scratch_bytes();
+    st.fragment_overflows += r->overflow_count();
+  }
+  st.fragment_overflows -= overflows_before;  // the counters run over the Renderer's life
+  st.setup_ms = ms_between(t.setup, t.binning);
+  st.binning_ms = ms_between(t.binning, t.raster);
+  // The tile pass interleaves raster and resolve per tile; the resolve share is the summed
+  // per-thread resolve time spread over the threads that ran.
+  st.resolve_ms = resolve_total / std::max(1, threads);
+  st.raster_ms = std::max(0.0, ms_between(t.raster, t.post) - st.resolve_ms);
+  st.post_ms = ms_between(t.post, t.end);
+  st.render_ms = ms_between(t.setup, t.end);
+  st.threads = threads;
+  st.tile = options.tile;
+}
 
 Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
   int w = options.width > 0 ? options.width : scene.width;
@@ -214,116 +351,25 @@ Renderer::~Renderer() = default;
 
 RenderResult Renderer::render_frame() {
   Impl& im = *impl_;
-  RenderResult result;
-  result.color.width = im.width_px;
-  result.color.height = im.height_px;
-  result.color.rgb.assign(std::size_t(im.width_px) * im.height_px * 3, 0);
-  if (im.options.want_depth) {
-    result.depth.width = im.width_px;
-    result.depth.height = im.height_px;
-    result.depth.depth.assign(std::size_t(im.width_px) * im.height_px, 1.0f);
-  }
-  detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
-                             im.scene.background_linear};
-  for (auto& c : im.setup_counters) c = {};
-  std::uint64_t overflows_before = 0;
-  for (const auto& r : im.rasterizers) overflows_before += r->overflow_count();
-  for (auto& r : im.resolve_thread_ms) r = 0;
-
+  RenderResult result = im.blank_result();
+  const detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
+                                   im.scene.background_linear};
+  const std::uint64_t overflows_before = im.begin_frame_counters();
   Clock::time_point t0, t1, t2, t3, t4;
   im.arena.execute([&] {
     t0 = Clock::now();
-    // Setup, part 1: vertices to clip space, in fixed blocks per instance.
-    std::vector<std::pair<std::size_t, std::size_t>> blocks;
-    for (std::size_t i = 0; i < im.front_end.instance_count(); ++i) {
-      for (std::size_t v = 0; v < im.front_end.vertex_count(i); v += kVerticesPerBlock) {
-        blocks.emplace_back(i, v);
-      }
-    }
-    tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
-      auto [instance, begin] = blocks[b];
-      std::size_t end = std::min(begin + kVerticesPerBlock, im.front_end.vertex_count(instance));
-      im.front_end.transform_vertices(instance, begin, end);
-    });
-    // Setup, part 2: clip, snap and set up each chunk of triangles.
-    tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
-      // Room for one output per input in the chunk's slice (clipping can add more, and then
-      // the chunk moves to its own array).
-      im.chunk_triangles[c].reset(static_cast<TriangleSetup*>(im.setup_storage.data()) +
-                                      std::size_t(c) * detail::kTrianglesPerChunk,
-                                  im.front_end.chunk_triangle_count(c));
-      im.chunk_bounds[c].clear();
-      im.chunk_bounds[c].reserve(im.front_end.chunk_triangle_count(c));
-      im.front_end.setup_chunk(c, im.chunk_triangles[c], im.chunk_bounds[c],
-                               im.setup_counters.local());
-    });
+    im.set_up_triangles();
     t1 = Clock::now();
-    tbb::parallel_for(std::uint32_t(0), im.front_end.chunk_count(), [&](std::uint32_t c) {
-      detail::bin_chunk(im.grid, im.chunk_bounds[c], im.chunk_bins[c], im.bin_scratch.local());
-    });
+    im.bin_triangles();
     t2 = Clock::now();
-    tbb::parallel_for(
-        tbb::blocked_range<int>(0, im.grid.tile_count(), 1), [&](const tbb::blocked_range<int>& r) {
-          detail::TileRasterizer& raster = *im.rasterizers.local();
-          for (int tile = r.begin(); tile < r.end(); ++tile) {
-            raster.begin_tile(im.grid.tile_rect(tile), target);
-            for (std::size_t c = 0; c < im.chunk_bins.size(); ++c) {
-              const auto& tris = im.chunk_triangles[c];
-              const std::span<const std::uint32_t> list = im.chunk_bins[c].tile(tile);
-              for (std::size_t k = 0; k < list.size(); ++k) {
-                // The tile's triangles are scattered through the chunk: fetch
-                // the set-up (two cache lines) a few triangles ahead.
-                if (k + kPrefetchAhead < list.size()) {
-                  const char* ahead =
-                      reinterpret_cast<const char*>(&tris[list[k + kPrefetchAhead]]);
-                  __builtin_prefetch(ahead);
-                  __builtin_prefetch(ahead + 64);
-                }
-                raster.draw(tris[list[k]]);
-              }
-            }
-            // end_tile resolves; banded modes also rasterise there, and
-            // that part counts as raster.
-            const double deferred = raster.deferred_raster_ms();
-            Clock::time_point r0 = Clock::now();
-            raster.end_tile(target);
-            im.resolve_thread_ms.local() +=
-                ms_between(r0, Clock::now()) - (raster.deferred_raster_ms() - deferred);
-          }
-        });
+    im.raster_tiles(target);
     t3 = Clock::now();
     if (im.options.mode.kind == ModeKind::Fxaa) {
       post_process_fxaa(im.options.fxaa, im.post_input, im.post_luma, result.color);
     }
     t4 = Clock::now();
   });
-
-  RenderStats& st = result.stats;
-  st.triangles_in = im.front_end.triangle_count();
-  for (const auto& c : im.setup_counters) {
-    st.triangles_culled += c.culled;
-    st.triangles_clipped += c.clipped;
-    st.triangles_backface_culled += c.backface_culled;
-  }
-  for (const auto& tris : im.chunk_triangles) st.triangles_setup += tris.size();
-  for (const auto& b : im.chunk_bins) st.bin_entries += b.triangle_index.size();
-  double resolve_total = 0;
-  for (double r : im.resolve_thread_ms) resolve_total += r;
-  for (const auto& r : im.rasterizers) {
-    st.scratch_bytes += r->scratch_bytes();
-    st.fragment_overflows += r->overflow_count();
-  }
-  st.fragment_overflows -= overflows_before;  // the counters run over the Renderer's life
-  st.setup_ms = ms_between(t0, t1);
-  st.binning_ms = ms_between(t1, t2);
-  // The tile pass interleaves raster and resolve per tile; the resolve share is the summed
-  // per-thread resolve time spread over the threads that ran.
-  st.resolve_ms = resolve_total / std::max(1, im.threads);
-  st.raster_ms = std::max(0.0, ms_between(t2, t3) - st.resolve_ms);
-  st.post_ms = ms_between(t3, t4);
-  st.render_ms = ms_between(t0, t4);
-  st.threads = im.threads;
-  st.tile = im.options.tile;
+  im.fill_stats(result.stats, overflows_before, {t0, t1, t2, t3, t4});
   return result;
 }
 

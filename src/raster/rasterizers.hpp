@@ -16,9 +16,6 @@ std::unique_ptr<TileRasterizer> make_tile_rasterizer(const RenderMode& mode, int
 // Factories of the individual modes (raster/<mode>/*.cpp).
 std::unique_ptr<TileRasterizer> make_aliased_rasterizer(int tile_px);
 std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend);
-/// Tests: coverage rasterizers made from now on add every pixel one by one (no whole-tile or
-/// whole-block paths), which must give the same bytes.
-void force_coverage_pixel_path(bool on);
 /// ssaa:N, ssaa-grid:N and ssaa-cmj:N (mode.kind picks the pattern, mode.samples is N).
 std::unique_ptr<TileRasterizer> make_ssaa_rasterizer(int tile_px, const RenderMode& mode);
 std::unique_ptr<TileRasterizer> make_msaa_rasterizer(int tile_px, int k);

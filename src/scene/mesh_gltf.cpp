@@ -360,11 +360,9 @@ std::vector<glm::vec3> primitive_normals(const Reader& reader, const tinygltf::P
   return world_normals(values, world);
 }
 
-}  // namespace
-
-LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir) {
-  const std::string& name = display_name;
+/// The file as tinygltf reads it (images accepted without decoding); its message on failure.
+tinygltf::Model read_model(std::string_view bytes, const std::string& name,
+                           const std::filesystem::path& base_dir) {
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&skip_image, nullptr);
@@ -379,221 +377,289 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
           : loader.LoadASCIIFromString(&model, &err, &warn, bytes.data(),
                                        static_cast<unsigned>(bytes.size()), base_dir.string());
   if (!ok) throw InputError(loader_error_message(name, err));
+  return model;
+}
 
-  const Reader reader{model, name};
-  const std::size_t node_count = model.nodes.size();
-
-  // Roots: the chosen scene's nodes, or every node that is nobody's child.
+/// Where the node walk starts: the chosen scene's nodes, or every node that is nobody's child
+/// when the file has no scene.
+std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& name) {
   std::vector<int> roots;
   if (!model.scenes.empty()) {
     const int scene_index = model.defaultScene >= 0 ? model.defaultScene : 0;
     if (static_cast<std::size_t>(scene_index) >= model.scenes.size()) {
       fail(name, "scene " + std::to_string(scene_index) + " does not exist");
     }
-    roots = model.scenes[static_cast<std::size_t>(scene_index)].nodes;
-  } else {
-    std::vector<bool> is_child(node_count, false);
-    for (const tinygltf::Node& node : model.nodes) {
-      for (const int child : node.children) {
-        if (child >= 0 && static_cast<std::size_t>(child) < node_count) {
-          is_child[static_cast<std::size_t>(child)] = true;
-        }
+    return model.scenes[static_cast<std::size_t>(scene_index)].nodes;
+  }
+  const std::size_t node_count = model.nodes.size();
+  std::vector<bool> is_child(node_count, false);
+  for (const tinygltf::Node& node : model.nodes) {
+    for (const int child : node.children) {
+      if (child >= 0 && static_cast<std::size_t>(child) < node_count) {
+        is_child[static_cast<std::size_t>(child)] = true;
       }
     }
-    for (std::size_t i = 0; i < node_count; ++i) {
-      if (!is_child[i]) roots.push_back(static_cast<int>(i));
+  }
+  for (std::size_t i = 0; i < node_count; ++i) {
+    if (!is_child[i]) roots.push_back(static_cast<int>(i));
+  }
+  return roots;
+}
+
+/// Collects the triangle primitives of the node tree into one MeshData: positions, indices,
+/// materials and normals as it goes, and the colours with what decides between vertex
+/// colours and one uniform colour (LoadedMesh::has_uniform_color) at the end.
+class GltfMeshBuilder {
+ public:
+  GltfMeshBuilder(const tinygltf::Model& model, const std::string& name)
+      : model_(model), name_(name), reader_{model, name}, mesh_(std::make_shared<MeshData>()) {
+    mesh_->source = name;
+    // The file's materials, then glTF's default material for primitives without one.
+    for (const tinygltf::Material& material : model.materials) {
+      mesh_->materials.push_back(convert_material(material));
+      if (material.emissiveTexture.index >= 0) ++emissive_textures_;
+    }
+    mesh_->materials.push_back(convert_material(tinygltf::Material{}));
+    default_material_ = static_cast<std::uint32_t>(model.materials.size());
+  }
+
+  /// Walks the node trees under `roots` depth first, in file order, composing the node
+  /// transforms, and adds every mesh it meets once per node that uses it.
+  void add_node_trees(const std::vector<int>& roots) {
+    struct Pending {
+      int node;
+      glm::dmat4 parent;
+    };
+    const std::size_t node_count = model_.nodes.size();
+    std::vector<Pending> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
+      stack.push_back({*it, glm::dmat4(1.0)});
+    }
+    std::vector<bool> visited(node_count, false);
+    while (!stack.empty()) {
+      const Pending current = stack.back();
+      stack.pop_back();
+      if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
+        fail(name_, "node " + std::to_string(current.node) + " does not exist");
+      }
+      const auto node_index = static_cast<std::size_t>(current.node);
+      if (visited[node_index]) {
+        fail(name_, "node " + std::to_string(current.node) +
+                        " is reached twice (the node hierarchy must be a tree)");
+      }
+      visited[node_index] = true;
+      const tinygltf::Node& node = model_.nodes[node_index];
+      const glm::dmat4 world = current.parent * local_transform(node, name_, current.node);
+      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
+        stack.push_back({*it, world});
+      }
+      if (node.mesh >= 0) add_mesh(current.node, node.mesh, world);
     }
   }
 
-  auto mesh = std::make_shared<MeshData>();
-  mesh->source = display_name;
-  // The file's materials, then glTF's default material for primitives without one.
-  std::size_t emissive_textures = 0;
-  for (const tinygltf::Material& material : model.materials) {
-    mesh->materials.push_back(convert_material(material));
-    if (material.emissiveTexture.index >= 0) ++emissive_textures;
+  LoadedMesh finish() {
+    LoadedMesh loaded;
+    if (emissive_textures_ > 0) {
+      loaded.lit_warnings.push_back(name_ + ": " + std::to_string(emissive_textures_) +
+                                    " materials with an emissive texture: textures are not "
+                                    "rendered yet, their emission is left out");
+    }
+    if (any_color_attribute_ || factors_differ_) {
+      // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
+      mesh_->colors_linear = std::move(colors_);
+    } else if (any_primitive_) {
+      loaded.has_uniform_color = true;
+      loaded.uniform_color_linear = first_factor_;
+    }
+    loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh_);
+    analyze_mesh_topology(*mesh_);  // once per file: instances share the result
+    loaded.data = std::move(mesh_);
+    return loaded;
   }
-  mesh->materials.push_back(convert_material(tinygltf::Material{}));
-  const auto default_material = static_cast<std::uint32_t>(model.materials.size());
-  bool any_normals = false;
-  std::vector<glm::vec3> colors;  // per vertex: COLOR_0 x factor, or the factor alone
-  bool any_color_attribute = false;
-  bool any_primitive = false;
-  bool factors_differ = false;
-  glm::vec3 first_factor(1.0f);
 
-  struct Pending {
-    int node;
-    glm::dmat4 parent;
-  };
-  std::vector<Pending> stack;
-  for (auto it = roots.rbegin(); it != roots.rend(); ++it) stack.push_back({*it, glm::dmat4(1.0)});
-  std::vector<bool> visited(node_count, false);
-  while (!stack.empty()) {
-    const Pending current = stack.back();
-    stack.pop_back();
-    if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
-      fail(name, "node " + std::to_string(current.node) + " does not exist");
+ private:
+  /// Mesh `mesh_index` of node `node_index`, with the node's world transform.
+  void add_mesh(int node_index, int mesh_index, const glm::dmat4& world) {
+    if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size()) {
+      fail(name_, "node " + std::to_string(node_index) + ": mesh " + std::to_string(mesh_index) +
+                      " does not exist");
     }
-    const auto node_index = static_cast<std::size_t>(current.node);
-    if (visited[node_index]) {
-      fail(name, "node " + std::to_string(current.node) +
-                     " is reached twice (the node hierarchy must be a tree)");
-    }
-    visited[node_index] = true;
-    const tinygltf::Node& node = model.nodes[node_index];
-    const glm::dmat4 world = current.parent * local_transform(node, name, current.node);
-    for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
-      stack.push_back({*it, world});
-    }
-    if (node.mesh < 0) continue;
-    if (static_cast<std::size_t>(node.mesh) >= model.meshes.size()) {
-      fail(name, "node " + std::to_string(current.node) + ": mesh " + std::to_string(node.mesh) +
-                     " does not exist");
-    }
-    const tinygltf::Mesh& gltf_mesh = model.meshes[static_cast<std::size_t>(node.mesh)];
+    const tinygltf::Mesh& gltf_mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
     for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = gltf_mesh.primitives[p];
-      const std::string what =
-          "mesh " + std::to_string(node.mesh) + " primitive " + std::to_string(p);
       const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
       if (mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips, fans: not drawn
-
-      const auto position_it = primitive.attributes.find("POSITION");
-      if (position_it == primitive.attributes.end()) fail(name, what + ": no POSITION attribute");
-      int components = 0;
-      const std::vector<double> positions =
-          reader.read_accessor(what + " POSITION", position_it->second, components);
-      if (components != 3) fail(name, what + ": POSITION must be VEC3");
-      const std::size_t vertex_count = positions.size() / 3;
-      const std::size_t base = mesh->positions.size();
-      if (vertex_count > kMaxVertices - base) fail(name, "too many vertices");
-
-      glm::dvec3 factor(1.0);
-      if (primitive.material >= 0) {
-        if (static_cast<std::size_t>(primitive.material) >= model.materials.size()) {
-          fail(name, what + ": material " + std::to_string(primitive.material) + " does not exist");
-        }
-        const std::vector<double>& f = model.materials[static_cast<std::size_t>(primitive.material)]
-                                           .pbrMetallicRoughness.baseColorFactor;
-        if (f.size() >= 3) factor = glm::dvec3(f[0], f[1], f[2]);
-      }
-      const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
-                                     clamp_unit(factor.b));
-      if (!any_primitive) {
-        first_factor = factor_clamped;
-      } else if (factor_clamped != first_factor) {
-        factors_differ = true;
-      }
-      any_primitive = true;
-
-      for (std::size_t v = 0; v < vertex_count; ++v) {
-        const glm::dvec4 p_world =
-            world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0);
-        mesh->positions.emplace_back(static_cast<float>(p_world.x), static_cast<float>(p_world.y),
-                                     static_cast<float>(p_world.z));
-      }
-
-      const auto color_it = primitive.attributes.find("COLOR_0");
-      if (color_it != primitive.attributes.end()) {
-        any_color_attribute = true;
-        int color_components = 0;
-        const std::vector<double> color_values =
-            reader.read_accessor(what + " COLOR_0", color_it->second, color_components);
-        if (color_components != 3 && color_components != 4) {
-          fail(name, what + ": COLOR_0 must be VEC3 or VEC4");
-        }
-        const auto width = static_cast<std::size_t>(color_components);
-        if (color_values.size() / width != vertex_count) {
-          fail(name, what + ": COLOR_0 and POSITION counts differ");
-        }
-        for (std::size_t v = 0; v < vertex_count; ++v) {
-          colors.emplace_back(clamp_unit(color_values[width * v] * factor.r),
-                              clamp_unit(color_values[width * v + 1] * factor.g),
-                              clamp_unit(color_values[width * v + 2] * factor.b));
-        }
-      } else {
-        colors.insert(colors.end(), vertex_count, factor_clamped);
-      }
-
-      // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
-      // clockwise; swapping two corners keeps counter-clockwise = front after baking.
-      const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
-      const std::size_t first_index = mesh->indices.size();
-      if (primitive.indices >= 0) {
-        int index_components = 0;
-        const std::vector<double> indices =
-            reader.read_accessor(what + " indices", primitive.indices, index_components);
-        const int index_type =
-            model.accessors[static_cast<std::size_t>(primitive.indices)].componentType;
-        if (index_components != 1 || (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-                                      index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-                                      index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
-          fail(name, what + ": indices must be unsigned byte, short or int scalars");
-        }
-        if (indices.size() % 3 != 0) {
-          fail(name, what + ": index count " + std::to_string(indices.size()) +
-                         " is not a multiple of 3");
-        }
-        for (const double index : indices) {
-          if (index >= static_cast<double>(vertex_count)) {
-            fail(name, what + ": index " + std::to_string(static_cast<std::uint64_t>(index)) +
-                           " out of range (" + std::to_string(vertex_count) + " vertices)");
-          }
-          mesh->indices.push_back(
-              static_cast<std::uint32_t>(base + static_cast<std::size_t>(index)));
-        }
-      } else {
-        if (vertex_count % 3 != 0) {
-          fail(name,
-               what + ": vertex count " + std::to_string(vertex_count) + " is not a multiple of 3");
-        }
-        for (std::size_t v = 0; v < vertex_count; ++v) {
-          mesh->indices.push_back(static_cast<std::uint32_t>(base + v));
-        }
-      }
-      if (mirrored) {
-        for (std::size_t i = first_index; i < mesh->indices.size(); i += 3) {
-          std::swap(mesh->indices[i + 1], mesh->indices[i + 2]);
-        }
-      }
-      const std::uint32_t material = primitive.material >= 0
-                                         ? static_cast<std::uint32_t>(primitive.material)
-                                         : default_material;
-      mesh->triangle_materials.resize(mesh->indices.size() / 3, material);
-      const std::vector<glm::vec3> normals =
-          primitive_normals(reader, primitive, what, world, vertex_count);
-      if (!normals.empty() && !any_normals) {
-        // Triangles before the first primitive with NORMAL: no normal (face normals).
-        mesh->corner_normals.assign(first_index, glm::vec3(0.0f));
-        any_normals = true;
-      }
-      if (any_normals) {
-        for (std::size_t i = first_index; i < mesh->indices.size(); ++i) {
-          mesh->corner_normals.push_back(normals.empty() ? glm::vec3(0.0f)
-                                                         : normals[mesh->indices[i] - base]);
-        }
-      }
+      add_primitive(primitive,
+                    "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p),
+                    world);
     }
   }
 
-  LoadedMesh loaded;
-  if (emissive_textures > 0) {
-    loaded.lit_warnings.push_back(name + ": " + std::to_string(emissive_textures) +
-                                  " materials with an emissive texture: textures are not "
-                                  "rendered yet, their emission is left out");
+  /// One mode-TRIANGLES primitive; `what` names it in messages.
+  void add_primitive(const tinygltf::Primitive& primitive, const std::string& what,
+                     const glm::dmat4& world) {
+    const auto position_it = primitive.attributes.find("POSITION");
+    if (position_it == primitive.attributes.end()) fail(name_, what + ": no POSITION attribute");
+    int components = 0;
+    const std::vector<double> positions =
+        reader_.read_accessor(what + " POSITION", position_it->second, components);
+    if (components != 3) fail(name_, what + ": POSITION must be VEC3");
+    const std::size_t vertex_count = positions.size() / 3;
+    const std::size_t base = mesh_->positions.size();
+    if (vertex_count > kMaxVertices - base) fail(name_, "too many vertices");
+
+    const glm::dvec3 factor = base_color_factor(primitive, what);
+    const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
+                                   clamp_unit(factor.b));
+    if (!any_primitive_) {
+      first_factor_ = factor_clamped;
+    } else if (factor_clamped != first_factor_) {
+      factors_differ_ = true;
+    }
+    any_primitive_ = true;
+
+    for (std::size_t v = 0; v < vertex_count; ++v) {
+      const glm::dvec4 p_world =
+          world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0);
+      mesh_->positions.emplace_back(static_cast<float>(p_world.x), static_cast<float>(p_world.y),
+                                    static_cast<float>(p_world.z));
+    }
+    add_colors(primitive, what, vertex_count, factor, factor_clamped);
+
+    const std::size_t first_index = mesh_->indices.size();
+    add_indices(primitive, what, vertex_count, base);
+    // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
+    // clockwise; swapping two corners keeps counter-clockwise = front after baking.
+    if (glm::determinant(glm::dmat3(world)) < 0.0) {
+      for (std::size_t i = first_index; i < mesh_->indices.size(); i += 3) {
+        std::swap(mesh_->indices[i + 1], mesh_->indices[i + 2]);
+      }
+    }
+    const std::uint32_t material = primitive.material >= 0
+                                       ? static_cast<std::uint32_t>(primitive.material)
+                                       : default_material_;
+    mesh_->triangle_materials.resize(mesh_->indices.size() / 3, material);
+    add_corner_normals(primitive_normals(reader_, primitive, what, world, vertex_count), base,
+                       first_index);
   }
-  if (any_color_attribute || factors_differ) {
-    // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
-    mesh->colors_linear = std::move(colors);
-  } else if (any_primitive) {
-    loaded.has_uniform_color = true;
-    loaded.uniform_color_linear = first_factor;
+
+  /// The primitive's material's baseColorFactor (RGB), or 1 without a material.
+  glm::dvec3 base_color_factor(const tinygltf::Primitive& primitive,
+                               const std::string& what) const {
+    glm::dvec3 factor(1.0);
+    if (primitive.material >= 0) {
+      if (static_cast<std::size_t>(primitive.material) >= model_.materials.size()) {
+        fail(name_, what + ": material " + std::to_string(primitive.material) + " does not exist");
+      }
+      const std::vector<double>& f = model_.materials[static_cast<std::size_t>(primitive.material)]
+                                         .pbrMetallicRoughness.baseColorFactor;
+      if (f.size() >= 3) factor = glm::dvec3(f[0], f[1], f[2]);
+    }
+    return factor;
   }
-  loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
-  analyze_mesh_topology(*mesh);  // once per file: instances share the result
-  loaded.data = std::move(mesh);
-  return loaded;
+
+  /// The primitive's vertex colours: COLOR_0 x factor, or the (clamped) factor alone.
+  void add_colors(const tinygltf::Primitive& primitive, const std::string& what,
+                  std::size_t vertex_count, glm::dvec3 factor, glm::vec3 factor_clamped) {
+    const auto color_it = primitive.attributes.find("COLOR_0");
+    if (color_it == primitive.attributes.end()) {
+      colors_.insert(colors_.end(), vertex_count, factor_clamped);
+      return;
+    }
+    any_color_attribute_ = true;
+    int color_components = 0;
+    const std::vector<double> color_values =
+        reader_.read_accessor(what + " COLOR_0", color_it->second, color_components);
+    if (color_components != 3 && color_components != 4) {
+      fail(name_, what + ": COLOR_0 must be VEC3 or VEC4");
+    }
+    const auto width = static_cast<std::size_t>(color_components);
+    if (color_values.size() / width != vertex_count) {
+      fail(name_, what + ": COLOR_0 and POSITION counts differ");
+    }
+    for (std::size_t v = 0; v < vertex_count; ++v) {
+      colors_.emplace_back(clamp_unit(color_values[width * v] * factor.r),
+                           clamp_unit(color_values[width * v + 1] * factor.g),
+                           clamp_unit(color_values[width * v + 2] * factor.b));
+    }
+  }
+
+  /// The primitive's triangles as mesh indices (its vertices start at `base`): its index
+  /// accessor, or consecutive vertices when it has none.
+  void add_indices(const tinygltf::Primitive& primitive, const std::string& what,
+                   std::size_t vertex_count, std::size_t base) {
+    if (primitive.indices < 0) {
+      if (vertex_count % 3 != 0) {
+        fail(name_,
+             what + ": vertex count " + std::to_string(vertex_count) + " is not a multiple of 3");
+      }
+      for (std::size_t v = 0; v < vertex_count; ++v) {
+        mesh_->indices.push_back(static_cast<std::uint32_t>(base + v));
+      }
+      return;
+    }
+    int index_components = 0;
+    const std::vector<double> indices =
+        reader_.read_accessor(what + " indices", primitive.indices, index_components);
+    const int index_type =
+        model_.accessors[static_cast<std::size_t>(primitive.indices)].componentType;
+    if (index_components != 1 || (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
+                                  index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
+                                  index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
+      fail(name_, what + ": indices must be unsigned byte, short or int scalars");
+    }
+    if (indices.size() % 3 != 0) {
+      fail(name_,
+           what + ": index count " + std::to_string(indices.size()) + " is not a multiple of 3");
+    }
+    for (const double index : indices) {
+      if (index >= static_cast<double>(vertex_count)) {
+        fail(name_, what + ": index " + std::to_string(static_cast<std::uint64_t>(index)) +
+                        " out of range (" + std::to_string(vertex_count) + " vertices)");
+      }
+      mesh_->indices.push_back(static_cast<std::uint32_t>(base + static_cast<std::size_t>(index)));
+    }
+  }
+
+  /// Corner normals of the indices from `first_index` on, from the primitive's world normals
+  /// (empty: none, face normals). The mesh has corner normals from its first primitive with
+  /// NORMAL on; corners before it get none.
+  void add_corner_normals(const std::vector<glm::vec3>& normals, std::size_t base,
+                          std::size_t first_index) {
+    if (!normals.empty() && !any_normals_) {
+      mesh_->corner_normals.assign(first_index, glm::vec3(0.0f));
+      any_normals_ = true;
+    }
+    if (!any_normals_) return;
+    for (std::size_t i = first_index; i < mesh_->indices.size(); ++i) {
+      mesh_->corner_normals.push_back(normals.empty() ? glm::vec3(0.0f)
+                                                      : normals[mesh_->indices[i] - base]);
+    }
+  }
+
+  const tinygltf::Model& model_;
+  const std::string& name_;
+  const Reader reader_;
+  std::shared_ptr<MeshData> mesh_;
+  std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
+  std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
+  bool any_normals_ = false;
+  std::vector<glm::vec3> colors_;  ///< per vertex: COLOR_0 x factor, or the factor alone
+  bool any_color_attribute_ = false;
+  bool any_primitive_ = false;
+  bool factors_differ_ = false;
+  glm::vec3 first_factor_{1.0f};  ///< the first primitive's clamped baseColorFactor
+};
+
+}  // namespace
+
+LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
+                      const std::filesystem::path& base_dir) {
+  const tinygltf::Model model = read_model(bytes, display_name, base_dir);
+  const std::vector<int> roots = root_nodes(model, display_name);
+  GltfMeshBuilder builder(model, display_name);
+  builder.add_node_trees(roots);
+  return builder.finish();
 }
 
 }  // namespace covrast::detail

@@ -133,141 +133,177 @@ void resolve_corner_normals(const std::vector<long long>& refs,
                               std::to_string(normals.size()) + " vn lines); face normals used");
   }
 }
+
+/// One OBJ file's statements, read line by line into a MeshData.
+class ObjParser {
+ public:
+  explicit ObjParser(const std::string& name) : name_(name), mesh_(std::make_shared<MeshData>()) {
+    mesh_->source = name;
+  }
+
+  /// One line, without its line end; `line_no` counts from 1.
+  void read_line(std::string_view line, std::size_t line_no) {
+    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
+      line = line.substr(0, hash);
+    }
+    Tokens tokens(line);
+    std::string_view keyword;
+    if (!tokens.next(keyword)) return;
+    if (keyword == "v") {
+      read_vertex(tokens, line_no);
+    } else if (keyword == "vn") {
+      read_normal(tokens, line_no);
+    } else if (keyword == "f") {
+      read_face(tokens, line_no);
+    }
+  }
+
+  /// After the last line: checks the forward references, converts the colours and resolves
+  /// the corner normals.
+  LoadedMesh finish() {
+    if (max_forward_index_ > static_cast<long long>(mesh_->positions.size())) {
+      fail(name_, max_forward_line_, out_of_range(max_forward_index_, mesh_->positions.size()));
+    }
+    if (any_color_) {
+      mesh_->colors_linear.reserve(colors_srgb_.size());
+      for (const glm::vec3& c : colors_srgb_) {
+        mesh_->colors_linear.emplace_back(srgb_to_linear(c.r), srgb_to_linear(c.g),
+                                          srgb_to_linear(c.b));
+      }
+    }
+    LoadedMesh loaded;
+    loaded.data = mesh_;
+    if (any_face_normal_) resolve_corner_normals(normal_refs_, normals_, name_, loaded);
+    loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh_);
+    analyze_mesh_topology(*mesh_);  // once per file: instances share the result
+    loaded.data = std::move(mesh_);
+    return loaded;
+  }
+
+ private:
+  /// "v x y z", "v x y z w" or "v x y z r g b".
+  void read_vertex(Tokens& tokens, std::size_t line_no) {
+    double values[6] = {0.0, 0.0, 0.0, 1.0, 1.0, 1.0};
+    int count = 0;
+    std::string_view token;
+    while (tokens.next(token)) {
+      double value = 0.0;
+      if (!parse_double(token, value))
+        fail(name_, line_no, "bad number '" + printable(token) + "'");
+      if (count < 6) values[count] = value;
+      ++count;
+    }
+    if (count < 3) fail(name_, line_no, "vertex needs x y z");
+    if (mesh_->positions.size() >= kMaxVertices) fail(name_, line_no, "too many vertices");
+    mesh_->positions.emplace_back(static_cast<float>(values[0]), static_cast<float>(values[1]),
+                                  static_cast<float>(values[2]));
+    // "v x y z w" carries a rational weight (meaningless for polygons); 6 or more numbers
+    // are "v x y z r g b" with sRGB display values.
+    if (count >= 6) any_color_ = true;
+    colors_srgb_.emplace_back(static_cast<float>(values[3]), static_cast<float>(values[4]),
+                              static_cast<float>(values[5]));
+    if (count < 6) colors_srgb_.back() = glm::vec3(1.0f);
+  }
+
+  /// "vn x y z".
+  void read_normal(Tokens& tokens, std::size_t line_no) {
+    double values[3] = {0.0, 0.0, 0.0};
+    int count = 0;
+    std::string_view token;
+    while (tokens.next(token)) {
+      if (count < 3 && !parse_double(token, values[count])) {
+        fail(name_, line_no, "bad number '" + printable(token) + "'");
+      }
+      ++count;
+    }
+    if (count != 3) fail(name_, line_no, "normal needs x y z");
+    normals_.emplace_back(static_cast<float>(values[0]), static_cast<float>(values[1]),
+                          static_cast<float>(values[2]));
+  }
+
+  /// "f" and its corners; the polygon becomes the fan (0, k, k + 1).
+  void read_face(Tokens& tokens, std::size_t line_no) {
+    corners_.clear();
+    corner_normals_.clear();
+    std::string_view token;
+    while (tokens.next(token)) {
+      corners_.push_back(corner_vertex(token, line_no));
+      corner_normals_.push_back(corner_normal(token, normals_.size(), name_, line_no));
+    }
+    if (corners_.size() < 3) {
+      fail(name_, line_no,
+           "face needs at least 3 vertices, got " + std::to_string(corners_.size()));
+    }
+    const bool face_normals = std::any_of(corner_normals_.begin(), corner_normals_.end(),
+                                          [](long long n) { return n != kNoNormal; });
+    if (face_normals && !any_face_normal_) {
+      // Faces before the first with normals: none (the face normal).
+      normal_refs_.assign(mesh_->indices.size(), kNoNormal);
+      any_face_normal_ = true;
+    }
+    for (std::size_t k = 1; k + 1 < corners_.size(); ++k) {
+      for (const std::size_t c : {std::size_t(0), k, k + 1}) {
+        mesh_->indices.push_back(corners_[c]);
+        if (any_face_normal_) normal_refs_.push_back(corner_normals_[c]);
+      }
+    }
+  }
+
+  /// The 0-based vertex of a face corner "i", "i/t", "i//n" or "i/t/n": i > 0 counts from 1,
+  /// i < 0 back from the latest vertex. A positive index past the vertices read so far is
+  /// remembered and checked by finish().
+  std::uint32_t corner_vertex(std::string_view token, std::size_t line_no) {
+    const auto vertex_count = static_cast<long long>(mesh_->positions.size());
+    const std::string_view index_text = token.substr(0, token.find('/'));
+    long long index = 0;
+    if (!parse_integer(index_text, index)) {
+      fail(name_, line_no, "bad face vertex '" + printable(token) + "'");
+    }
+    if (index == 0) fail(name_, line_no, out_of_range(index, mesh_->positions.size()));
+    if (index < 0) {
+      const long long resolved = vertex_count + index;
+      if (resolved < 0) fail(name_, line_no, out_of_range(index, mesh_->positions.size()));
+      return static_cast<std::uint32_t>(resolved);
+    }
+    if (index > static_cast<long long>(kMaxVertices)) {
+      fail(name_, line_no, out_of_range(index, mesh_->positions.size()));
+    }
+    if (index > vertex_count && index > max_forward_index_) {
+      max_forward_index_ = index;
+      max_forward_line_ = line_no;
+    }
+    return static_cast<std::uint32_t>(index - 1);
+  }
+
+  const std::string& name_;
+  std::shared_ptr<MeshData> mesh_;
+  std::vector<glm::vec3> colors_srgb_;  ///< one per vertex, white where the file gives none
+  bool any_color_ = false;
+  std::vector<std::uint32_t> corners_;     ///< of the current face
+  std::vector<glm::vec3> normals_;         ///< vn lines, in file order
+  std::vector<long long> corner_normals_;  ///< of the current face: see corner_normal()
+  std::vector<long long> normal_refs_;     ///< per triangle corner, as corner_normals_
+  bool any_face_normal_ = false;
+  /// Positive indices may point past the vertices read so far (OBJ does not forbid forward
+  /// references); the largest one is checked against the final count at the end.
+  long long max_forward_index_ = 0;
+  std::size_t max_forward_line_ = 0;
+};
+
 }  // namespace
 
 LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
-  auto mesh = std::make_shared<MeshData>();
-  mesh->source = display_name;
-  std::vector<glm::vec3> colors_srgb;  // one per vertex, white where the file gives none
-  bool any_color = false;
-  std::vector<std::uint32_t> corners;
-  std::vector<glm::vec3> normals;         // vn lines, in file order
-  std::vector<long long> corner_normals;  // of the current face: see corner_normal()
-  std::vector<long long> normal_refs;     // per triangle corner, as corner_normals
-  bool any_face_normal = false;
-  // Positive indices may point past the vertices read so far (OBJ does not forbid forward
-  // references); the largest one is checked against the final count at the end.
-  long long max_forward_index = 0;
-  std::size_t max_forward_line = 0;
-
+  ObjParser parser(display_name);
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   std::size_t pos = 0;
   std::size_t line_no = 0;
   while (pos < text.size()) {
     std::size_t end = text.find('\n', pos);
     if (end == std::string_view::npos) end = text.size();
-    std::string_view line = text.substr(pos, end - pos);
+    parser.read_line(text.substr(pos, end - pos), ++line_no);
     pos = end + 1;
-    ++line_no;
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
-    }
-    Tokens tokens(line);
-    std::string_view keyword;
-    if (!tokens.next(keyword)) continue;
-
-    if (keyword == "v") {
-      double values[6] = {0.0, 0.0, 0.0, 1.0, 1.0, 1.0};
-      int count = 0;
-      std::string_view token;
-      while (tokens.next(token)) {
-        double value = 0.0;
-        if (!parse_double(token, value))
-          fail(display_name, line_no, "bad number '" + printable(token) + "'");
-        if (count < 6) values[count] = value;
-        ++count;
-      }
-      if (count < 3) fail(display_name, line_no, "vertex needs x y z");
-      if (mesh->positions.size() >= kMaxVertices) fail(display_name, line_no, "too many vertices");
-      mesh->positions.emplace_back(static_cast<float>(values[0]), static_cast<float>(values[1]),
-                                   static_cast<float>(values[2]));
-      // "v x y z w" carries a rational weight (meaningless for polygons); 6 or more numbers
-      // are "v x y z r g b" with sRGB display values.
-      if (count >= 6) any_color = true;
-      colors_srgb.emplace_back(static_cast<float>(values[3]), static_cast<float>(values[4]),
-                               static_cast<float>(values[5]));
-      if (count < 6) colors_srgb.back() = glm::vec3(1.0f);
-    } else if (keyword == "vn") {
-      double values[3] = {0.0, 0.0, 0.0};
-      int count = 0;
-      std::string_view token;
-      while (tokens.next(token)) {
-        if (count < 3 && !parse_double(token, values[count])) {
-          fail(display_name, line_no, "bad number '" + printable(token) + "'");
-        }
-        ++count;
-      }
-      if (count != 3) fail(display_name, line_no, "normal needs x y z");
-      normals.emplace_back(static_cast<float>(values[0]), static_cast<float>(values[1]),
-                           static_cast<float>(values[2]));
-    } else if (keyword == "f") {
-      corners.clear();
-      corner_normals.clear();
-      const auto vertex_count = static_cast<long long>(mesh->positions.size());
-      std::string_view token;
-      while (tokens.next(token)) {
-        const std::string_view index_text = token.substr(0, token.find('/'));
-        long long index = 0;
-        if (!parse_integer(index_text, index)) {
-          fail(display_name, line_no, "bad face vertex '" + printable(token) + "'");
-        }
-        long long resolved = 0;
-        if (index > 0) {
-          if (index > static_cast<long long>(kMaxVertices)) {
-            fail(display_name, line_no, out_of_range(index, mesh->positions.size()));
-          }
-          resolved = index - 1;
-          if (index > vertex_count && index > max_forward_index) {
-            max_forward_index = index;
-            max_forward_line = line_no;
-          }
-        } else if (index < 0) {
-          resolved = vertex_count + index;
-          if (resolved < 0)
-            fail(display_name, line_no, out_of_range(index, mesh->positions.size()));
-        } else {
-          fail(display_name, line_no, out_of_range(index, mesh->positions.size()));
-        }
-        corners.push_back(static_cast<std::uint32_t>(resolved));
-        corner_normals.push_back(corner_normal(token, normals.size(), display_name, line_no));
-      }
-      if (corners.size() < 3) {
-        fail(display_name, line_no,
-             "face needs at least 3 vertices, got " + std::to_string(corners.size()));
-      }
-      const bool face_normals = std::any_of(corner_normals.begin(), corner_normals.end(),
-                                            [](long long n) { return n != kNoNormal; });
-      if (face_normals && !any_face_normal) {
-        // Faces before the first with normals: none (the face normal).
-        normal_refs.assign(mesh->indices.size(), kNoNormal);
-        any_face_normal = true;
-      }
-      for (std::size_t k = 1; k + 1 < corners.size(); ++k) {
-        for (const std::size_t c : {std::size_t(0), k, k + 1}) {
-          mesh->indices.push_back(corners[c]);
-          if (any_face_normal) normal_refs.push_back(corner_normals[c]);
-        }
-      }
-    }
   }
-  if (max_forward_index > static_cast<long long>(mesh->positions.size())) {
-    fail(display_name, max_forward_line, out_of_range(max_forward_index, mesh->positions.size()));
-  }
-
-  if (any_color) {
-    mesh->colors_linear.reserve(colors_srgb.size());
-    for (const glm::vec3& c : colors_srgb) {
-      mesh->colors_linear.emplace_back(srgb_to_linear(c.r), srgb_to_linear(c.g),
-                                       srgb_to_linear(c.b));
-    }
-  }
-  LoadedMesh loaded;
-  loaded.data = mesh;
-  if (any_face_normal) resolve_corner_normals(normal_refs, normals, display_name, loaded);
-  loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh);
-  analyze_mesh_topology(*mesh);  // once per file: instances share the result
-  loaded.data = std::move(mesh);
-  return loaded;
+  return parser.finish();
 }
 
 }  // namespace covrast::detail

@@ -400,6 +400,157 @@ void select_normals(const SceneReader& reader, const std::string& file, const js
   }
 }
 
+/// The mesh file an entry of "meshes" names: its format and its path as written.
+struct MeshFileRef {
+  MeshFormat format;
+  std::string relative;
+};
+
+/// Exactly one of "obj" and "gltf", a non-empty path string.
+MeshFileRef mesh_file_ref(const std::string& file, const json& entry, const std::string& key) {
+  const auto obj_it = entry.find("obj");
+  const auto gltf_it = entry.find("gltf");
+  if (obj_it != entry.end() && gltf_it != entry.end()) {
+    fail(file, key, "give either \"obj\" or \"gltf\", not both");
+  }
+  if (obj_it == entry.end() && gltf_it == entry.end()) {
+    fail(file, key, "needs \"obj\" or \"gltf\" (a mesh file path)");
+  }
+  const MeshFormat format = obj_it != entry.end() ? MeshFormat::Obj : MeshFormat::Gltf;
+  const json& path_value = format == MeshFormat::Obj ? *obj_it : *gltf_it;
+  const std::string path_key = key + (format == MeshFormat::Obj ? ".obj" : ".gltf");
+  if (!path_value.is_string() || path_value.get<std::string>().empty()) {
+    fail(file, path_key, "expected a file path string, got " + shown(path_value));
+  }
+  return {format, path_value.get<std::string>()};
+}
+
+/// The scene's mesh files, each read and parsed once however many instances name it
+/// (instancing: one load per canonical path and format).
+class MeshCache {
+ public:
+  MeshCache(const std::string& file, std::filesystem::path base_dir)
+      : file_(file), base_dir_(std::move(base_dir)) {}
+
+  /// The mesh that entry `key` names. On its first use the file is loaded and its warnings
+  /// go to `scene` (the lit ones only when the scene is lit).
+  CachedMesh& get(const MeshFileRef& ref, const std::string& key, Scene& scene) {
+    const std::filesystem::path full = base_dir_ / std::filesystem::path(ref.relative);
+    std::error_code ec;
+    const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
+    if (ec) fail(file_, key, "cannot open '" + ref.relative + "': " + ec.message());
+    auto cached = cache_.find({canonical.string(), ref.format});
+    if (cached != cache_.end()) return cached->second;
+    CachedMesh loaded_mesh;
+    loaded_mesh.loaded = load(full, ref, key);
+    const detail::LoadedMesh& loaded = loaded_mesh.loaded;
+    if (loaded.dropped_nonfinite_triangles > 0) {
+      scene.warnings.push_back(full.lexically_normal().string() + ": dropped " +
+                               std::to_string(loaded.dropped_nonfinite_triangles) +
+                               " triangles with NaN/Inf coordinates");
+    }
+    for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
+    if (scene.lit) {
+      for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
+    }
+    return cache_.emplace(std::make_pair(canonical.string(), ref.format), std::move(loaded_mesh))
+        .first->second;
+  }
+
+ private:
+  detail::LoadedMesh load(const std::filesystem::path& full, const MeshFileRef& ref,
+                          const std::string& key) const {
+    std::string bytes;
+    std::string error;
+    if (!detail::read_whole_file(full, bytes, error)) {
+      fail(file_, key, "cannot open '" + ref.relative + "': " + error);
+    }
+    const std::string display = full.lexically_normal().string();
+    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display)
+                                         : detail::parse_gltf(bytes, display, full.parent_path());
+  }
+
+  const std::string& file_;
+  std::filesystem::path base_dir_;
+  std::map<std::pair<std::string, MeshFormat>, CachedMesh> cache_;
+};
+
+/// The instance's colour selection: "color" or material.base_color (not both), else the
+/// file's vertex colours, else the file's uniform colour (glTF), else the default.
+void select_color(const SceneReader& reader, const std::string& file, const json& entry,
+                  const std::string& key, const std::string& relative,
+                  const detail::LoadedMesh& loaded, MeshInstance& instance) {
+  const bool has_vertex_colors = !loaded.data->colors_linear.empty();
+  // material.base_color is the same as "color": [r,g,b] (the base colour of a lit mesh is
+  // its colour selection).
+  const json* base_color = nullptr;
+  if (const auto it = entry.find("material"); it != entry.end() && it->is_object()) {
+    if (const auto bit = it->find("base_color"); bit != it->end()) base_color = &*bit;
+  }
+  const auto color_it = entry.find("color");
+  if (base_color != nullptr && color_it != entry.end()) {
+    fail(file, key + ".material.base_color", "give either it or \"color\", not both");
+  }
+  if (base_color != nullptr) {
+    instance.color_linear = reader.srgb_color(*base_color, key + ".material.base_color");
+  } else if (color_it != entry.end()) {
+    const json& color = *color_it;
+    const std::string color_key = key + ".color";
+    if (color.is_array()) {
+      instance.color_source = ColorSource::Uniform;
+      instance.color_linear = reader.srgb_color(color, color_key);
+    } else if (color.is_string() && color.get<std::string>() == "per_triangle") {
+      instance.color_source = ColorSource::PerTriangle;
+    } else if (color.is_string() && color.get<std::string>() == "vertex") {
+      if (!has_vertex_colors) {
+        fail(file, color_key, "\"vertex\" but '" + relative + "' has no vertex colours");
+      }
+      instance.color_source = ColorSource::Vertex;
+    } else {
+      fail(file, color_key,
+           "expected [r,g,b], \"per_triangle\" or \"vertex\", got " + shown(color));
+    }
+  } else if (has_vertex_colors) {
+    instance.color_source = ColorSource::Vertex;
+  } else if (loaded.has_uniform_color) {
+    instance.color_linear = loaded.uniform_color_linear;
+  }
+}
+
+/// Entry `key` of "meshes": its mesh (loaded through `cache`), colour, model matrix,
+/// materials and normals.
+MeshInstance load_instance(const SceneReader& reader, const std::string& file, const json& value,
+                           const std::string& key, MeshCache& cache, Scene& scene) {
+  const json& entry = reader.require_object(value, key);
+  const MeshFileRef ref = mesh_file_ref(file, entry, key);
+  CachedMesh& cached = cache.get(ref, key, scene);
+  const detail::LoadedMesh& loaded = cached.loaded;
+  // Counted per instance: each instance would have drawn the dropped triangles.
+  scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
+
+  MeshInstance instance;
+  instance.mesh = loaded.data;
+  select_color(reader, file, entry, key, ref.relative, loaded, instance);
+  if (const auto model_it = entry.find("model"); model_it != entry.end()) {
+    instance.model = reader.model_matrix(*model_it, key + ".model");
+  }
+  instance.materials = instance_materials(reader, entry, key, *loaded.data);
+  select_normals(reader, file, entry, key, ref.relative, cached, instance);
+  return instance;
+}
+
+/// The scene file's top-level JSON object.
+json read_scene_root(const std::filesystem::path& json_path, const std::string& file) {
+  std::string text;
+  std::string error;
+  if (!detail::read_whole_file(json_path, text, error)) {
+    throw InputError(file + ": cannot open: " + error);
+  }
+  json root = parse_json(text, file);
+  if (!root.is_object()) throw InputError(file + ": expected a JSON object at the top level");
+  return root;
+}
+
 }  // namespace
 
 std::size_t Scene::triangle_count() const {
@@ -412,13 +563,7 @@ std::size_t Scene::triangle_count() const {
 
 Scene load_scene(const std::filesystem::path& json_path) {
   const std::string file = json_path.string();
-  std::string text;
-  std::string error;
-  if (!detail::read_whole_file(json_path, text, error)) {
-    throw InputError(file + ": cannot open: " + error);
-  }
-  const json root = parse_json(text, file);
-  if (!root.is_object()) throw InputError(file + ": expected a JSON object at the top level");
+  const json root = read_scene_root(json_path, file);
   const SceneReader reader(file);
 
   Scene scene;
@@ -436,106 +581,10 @@ Scene load_scene(const std::filesystem::path& json_path) {
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  const std::filesystem::path base_dir = json_path.parent_path();
-  // Instancing: one load per (canonical path, format).
-  std::map<std::pair<std::string, MeshFormat>, CachedMesh> cache;
-
+  MeshCache cache(file, json_path.parent_path());
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string key = "meshes[" + std::to_string(i) + "]";
-    const json& entry = reader.require_object(meshes[i], key);
-    const auto obj_it = entry.find("obj");
-    const auto gltf_it = entry.find("gltf");
-    if (obj_it != entry.end() && gltf_it != entry.end()) {
-      fail(file, key, "give either \"obj\" or \"gltf\", not both");
-    }
-    if (obj_it == entry.end() && gltf_it == entry.end()) {
-      fail(file, key, "needs \"obj\" or \"gltf\" (a mesh file path)");
-    }
-    const MeshFormat format = obj_it != entry.end() ? MeshFormat::Obj : MeshFormat::Gltf;
-    const json& path_value = format == MeshFormat::Obj ? *obj_it : *gltf_it;
-    const std::string path_key = key + (format == MeshFormat::Obj ? ".obj" : ".gltf");
-    if (!path_value.is_string() || path_value.get<std::string>().empty()) {
-      fail(file, path_key, "expected a file path string, got " + shown(path_value));
-    }
-    const std::string relative = path_value.get<std::string>();
-    const std::filesystem::path full = base_dir / std::filesystem::path(relative);
-
-    std::error_code ec;
-    const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
-    if (ec) fail(file, key, "cannot open '" + relative + "': " + ec.message());
-    auto cached = cache.find({canonical.string(), format});
-    const bool first_use = cached == cache.end();
-    if (first_use) {
-      std::string bytes;
-      if (!detail::read_whole_file(full, bytes, error)) {
-        fail(file, key, "cannot open '" + relative + "': " + error);
-      }
-      const std::string display = full.lexically_normal().string();
-      CachedMesh entry_data;
-      entry_data.loaded = format == MeshFormat::Obj
-                              ? detail::parse_obj(bytes, display)
-                              : detail::parse_gltf(bytes, display, full.parent_path());
-      if (entry_data.loaded.dropped_nonfinite_triangles > 0) {
-        scene.warnings.push_back(display + ": dropped " +
-                                 std::to_string(entry_data.loaded.dropped_nonfinite_triangles) +
-                                 " triangles with NaN/Inf coordinates");
-      }
-      cached =
-          cache.emplace(std::make_pair(canonical.string(), format), std::move(entry_data)).first;
-    }
-    const detail::LoadedMesh& loaded = cached->second.loaded;
-    if (first_use) {
-      for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
-      if (scene.lit) {
-        for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
-      }
-    }
-    // Counted per instance: each instance would have drawn the dropped triangles.
-    scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
-
-    MeshInstance instance;
-    instance.mesh = loaded.data;
-    const bool has_vertex_colors = !loaded.data->colors_linear.empty();
-    // material.base_color is the same as "color": [r,g,b] (the base colour of a lit mesh is
-    // its colour selection).
-    const json* base_color = nullptr;
-    if (const auto it = entry.find("material"); it != entry.end() && it->is_object()) {
-      if (const auto bit = it->find("base_color"); bit != it->end()) base_color = &*bit;
-    }
-    const auto color_it = entry.find("color");
-    if (base_color != nullptr && color_it != entry.end()) {
-      fail(file, key + ".material.base_color", "give either it or \"color\", not both");
-    }
-    if (base_color != nullptr) {
-      instance.color_linear = reader.srgb_color(*base_color, key + ".material.base_color");
-    } else if (color_it != entry.end()) {
-      const json& color = *color_it;
-      const std::string color_key = key + ".color";
-      if (color.is_array()) {
-        instance.color_source = ColorSource::Uniform;
-        instance.color_linear = reader.srgb_color(color, color_key);
-      } else if (color.is_string() && color.get<std::string>() == "per_triangle") {
-        instance.color_source = ColorSource::PerTriangle;
-      } else if (color.is_string() && color.get<std::string>() == "vertex") {
-        if (!has_vertex_colors) {
-          fail(file, color_key, "\"vertex\" but '" + relative + "' has no vertex colours");
-        }
-        instance.color_source = ColorSource::Vertex;
-      } else {
-        fail(file, color_key,
-             "expected [r,g,b], \"per_triangle\" or \"vertex\", got " + shown(color));
-      }
-    } else if (has_vertex_colors) {
-      instance.color_source = ColorSource::Vertex;
-    } else if (loaded.has_uniform_color) {
-      instance.color_linear = loaded.uniform_color_linear;
-    }
-    if (const auto model_it = entry.find("model"); model_it != entry.end()) {
-      instance.model = reader.model_matrix(*model_it, key + ".model");
-    }
-    instance.materials = instance_materials(reader, entry, key, *loaded.data);
-    select_normals(reader, file, entry, key, relative, cached->second, instance);
-    scene.meshes.push_back(std::move(instance));
+    scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene));
   }
   return scene;
 }

@@ -90,7 +90,7 @@ void raster_aliased_scalar(const TriangleSetup& t, const PixelRect& r, const Ali
                            std::uint64_t id);
 
 /// The SIMD kernel of the target Highway dispatches to now (best supported, or forced with
-/// force_simd_target), looked up once: a rasterizer keeps the pointer.
+/// testing::force_simd_target), looked up once: a rasterizer keeps the pointer.
 RasterAliasedFn raster_aliased_simd();
 
 }  // namespace covrast::detail

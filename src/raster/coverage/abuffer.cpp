@@ -5,10 +5,10 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "core/edge_function.hpp"
+#include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
 
 namespace covrast::detail {
@@ -45,7 +45,12 @@ int compare_planes(const TriangleSetup& t, const TriangleSetup& u, const PixelRe
   return nearer == 4 ? 1 : farther == 4 ? -1 : 0;
 }
 
-std::atomic<int> g_capacity{kMaxFragmentsPerPixel};
+/// Fragments per pixel before the overflow policy: kMaxFragmentsPerPixel, or what a test
+/// asked for (testing::CoverageHooks::fragment_capacity).
+int fragment_capacity() {
+  const int forced = testing::coverage_hooks.fragment_capacity.load();
+  return forced <= 0 ? kMaxFragmentsPerPixel : std::clamp(forced, 2, kMaxFragmentsPerPixel);
+}
 
 }  // namespace
 
@@ -64,14 +69,9 @@ DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, i
   return DepthOrder::Crossing;
 }
 
-void force_abuffer_capacity(int fragments) {
-  g_capacity.store(fragments <= 0 ? kMaxFragmentsPerPixel
-                                  : std::clamp(fragments, 2, kMaxFragmentsPerPixel));
-}
-
 ABufferTile::ABufferTile(int tile_px)
     : stride_(tile_px),
-      capacity_(g_capacity.load()),
+      capacity_(fragment_capacity()),
       mixed_capacity_(std::min(capacity_, kMaxMixedFragments)),
       block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
   const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);

@@ -92,19 +92,6 @@ inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
   return (same[0] | same[1] | same[2]) != 0;
 }
 
-/// Tests: resolve every pixel from its fragment list, never from the one-layer sums (the
-/// two must give the same bytes).
-void force_abuffer_list_resolve(bool on);
-/// Tests: resolve every pixel with fragments by its sub-pixel samples, never by adding areas
-/// (neither the sums nor the disjoint-set branches of resolve_pixel): the reference that the
-/// exact-area paths must match within rounding.
-void force_abuffer_mask_resolve(bool on);
-/// Tests: A-buffers made from now on keep at most `fragments` per pixel (0: back to
-/// kMaxFragmentsPerPixel), so that the overflow policy can be exercised on small scenes.
-void force_abuffer_capacity(int fragments);
-/// Tests: pixels resolved from the one-layer sums so far, over all tiles and threads.
-std::uint64_t abuffer_layer_resolves();
-
 class ABufferTile {
  public:
   explicit ABufferTile(int tile_px);

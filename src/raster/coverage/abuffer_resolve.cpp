@@ -5,20 +5,16 @@
 
 #include "core/shading.hpp"
 #include "core/srgb8.hpp"
+#include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
 #include <limits>
 
 namespace covrast::detail {
 namespace {
-
-std::atomic<bool> g_list_resolve{false};
-std::atomic<bool> g_mask_resolve{false};
-std::atomic<std::uint64_t> g_layer_resolves{0};
 
 bool same_surface(const TriangleSetup& a, const TriangleSetup& b) {
   return a.surface == b.surface && a.front_facing == b.front_facing;
@@ -144,13 +140,6 @@ void fill_estimated_share(int n, const std::uint32_t* cov, const bool* estimated
 
 }  // namespace
 
-void force_abuffer_list_resolve(bool on) { g_list_resolve.store(on); }
-void force_abuffer_mask_resolve(bool on) {
-  g_mask_resolve.store(on);
-  g_list_resolve.store(on);
-}
-std::uint64_t abuffer_layer_resolves() { return g_layer_resolves.load(); }
-
 /// A layer in front of everything else: colour = (sum coverage_i colour_i) / max(sum
 /// coverage_i, 1) + (1 - min(sum coverage_i, 1)) * behind, in 8.8 units; a sum above one
 /// pixel (rounding, or merged pieces) is normalised.
@@ -211,7 +200,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   }
   if (n == 0) return behind;
 
-  const bool sums_allowed = !g_mask_resolve.load(std::memory_order_relaxed);
+  const bool sums_allowed = !testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed);
   // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
   // the open set's sums give; resolve() takes those directly where it can).
   auto layer_color = [&](const bool* member) {
@@ -317,7 +306,9 @@ void ABufferTile::resolve(const FrameTarget& target) {
     resolve_opaque_block(uniform_, rect_, target);
     return;
   }
-  const bool use_sums = !g_list_resolve.load(std::memory_order_relaxed);
+  testing::CoverageHooks& hooks = testing::coverage_hooks;
+  const bool use_sums = !hooks.list_resolve.load(std::memory_order_relaxed) &&
+                        !hooks.mask_resolve.load(std::memory_order_relaxed);
   std::uint64_t from_sums = 0;
   const int block_cols = (rect_.x1 - rect_.x0 + kBlockPx - 1) / kBlockPx;
   const int block_rows = (rect_.y1 - rect_.y0 + kBlockPx - 1) / kBlockPx;
@@ -357,6 +348,8 @@ void ABufferTile::resolve(const FrameTarget& target) {
       write_tile(target, br, color_.data() + first, depth_.data() + first, stride_);
     }
   }
-  g_layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
+  if (hooks.count_layer_resolves.load(std::memory_order_relaxed)) {
+    hooks.layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
+  }
 }
 }  // namespace covrast::detail

@@ -7,13 +7,13 @@
 //                    per pixel (kept to show what the A-buffer fixes).
 #include "core/shading.hpp"
 #include "core/srgb8.hpp"
+#include "core/testing_hooks.hpp"
 #include "core/tile_raster.hpp"
 #include "raster/coverage/abuffer.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
 #include "raster/rasterizers.hpp"
 
 #include <algorithm>
-#include <atomic>
 #include <bit>
 #include <climits>
 #include <limits>
@@ -22,8 +22,6 @@
 
 namespace covrast::detail {
 namespace {
-
-std::atomic<bool> g_pixel_path_only{false};
 
 // Aligned column groups lie in one A-buffer block (draw).
 static_assert(kColumnGroup == kAbufferBlockPx);
@@ -102,11 +100,6 @@ class CoverageRasterizer final : public TileRasterizer {
   }
   std::uint64_t overflow_count() const override { return abuffer_.overflow_count(); }
 
-  /// The per-group set-up and kernel; tests swap in the scalar twin.
-  CoverGroupFn cover_group_ = cover_group_simd;
-  /// The whole-tile and whole-block paths; tests turn them off to compare.
-  bool fast_paths_ = !g_pixel_path_only.load(std::memory_order_relaxed);
-
  private:
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
   void consume(const TriangleSetup& t, int g, int lanes, int first, int end, bool skip_decided) {
@@ -156,6 +149,14 @@ class CoverageRasterizer final : public TileRasterizer {
 
   int tile_px_;
   bool blend_;
+  /// The per-group set-up and kernel: the SIMD one, or its scalar twin for a test that
+  /// compares the two (testing::CoverageHooks::scalar_kernel).
+  CoverGroupFn cover_group_ = testing::coverage_hooks.scalar_kernel.load(std::memory_order_relaxed)
+                                  ? cover_group_scalar
+                                  : cover_group_simd;
+  /// The A-buffer's whole-tile and whole-block paths, on unless a test compares them with
+  /// pixel-by-pixel adds (testing::CoverageHooks::pixel_path_only).
+  bool fast_paths_ = !testing::coverage_hooks.pixel_path_only.load(std::memory_order_relaxed);
   const TriangleSetup* previous_ = nullptr;  ///< the tile's last drawn triangle (not blend)
   std::size_t plane_stride_;
   PixelRect rect_;
@@ -167,8 +168,6 @@ class CoverageRasterizer final : public TileRasterizer {
 };
 
 }  // namespace
-
-void force_coverage_pixel_path(bool on) { g_pixel_path_only.store(on); }
 
 std::unique_ptr<TileRasterizer> make_coverage_rasterizer(int tile_px, bool blend) {
   return std::make_unique<CoverageRasterizer>(tile_px, blend);

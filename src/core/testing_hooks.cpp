@@ -1,10 +1,10 @@
-// Shared layer: the Highway target switch (simd_target.hpp).
-#include "core/simd_target.hpp"
+// Shared layer: the SIMD target switch of the testing interface (testing_hooks.hpp).
+#include "core/testing_hooks.hpp"
 
 #include <hwy/highway.h>
 #include <hwy/targets.h>
 
-namespace covrast::detail {
+namespace covrast::detail::testing {
 
 std::int64_t compiled_simd_targets() { return HWY_TARGETS; }
 
@@ -20,4 +20,4 @@ const char* simd_target_name() {
   return hwy::TargetName(usable & -usable);
 }
 
-}  // namespace covrast::detail
+}  // namespace covrast::detail::testing
