@@ -13,8 +13,8 @@ build_packages=(
   nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev
 )
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for
-# the scene and report scripts.
-test_packages=(clang python3)
+# the scene and report scripts, chromium to load covrast test's HTML report headless.
+test_packages=(clang python3 chromium)
 
 # Usage: scripts/setup.sh [--build-only]
 packages=("${build_packages[@]}")

@@ -88,9 +88,9 @@ void junit_case(std::ostringstream& xml, const std::string& suite, const CaseRes
 const char* kReportStyle = R"(
 body { font: 14px/1.4 sans-serif; margin: 1.5em; color: #222; }
 h1 { font-size: 1.4em; } h2 { font-size: 1.1em; margin-top: 2em; }
-.build { color: #555; } .failed { color: #b00; } .passed { color: #070; }
+.build { color: #555; } .failed { color: #b00; } .passed { color: #070; } .skipped { color: #777; }
 .case { border-top: 1px solid #ccc; padding: 0.8em 0; }
-.images { display: flex; gap: 1em; flex-wrap: wrap; align-items: flex-start; }
+.images { display: flex; gap: 1em; overflow-x: auto; align-items: flex-start; }
 figure { margin: 0; } figcaption { color: #555; font-size: 0.9em; }
 img { image-rendering: pixelated; border: 1px solid #999; }
 table { border-collapse: collapse; } td, th { padding: 0.2em 0.8em; text-align: left; }
@@ -105,8 +105,15 @@ function zoom(factor) {
     img.style.width = (img.dataset.width * factor) + 'px';
   }
 }
-document.getElementById('zoom').addEventListener('input', e => zoom(e.target.value));
-zoom(document.getElementById('zoom').value);
+const slider = document.getElementById('zoom');
+slider.addEventListener('input', e => zoom(e.target.value));
+// Start at the largest factor that keeps golden, actual and heat map side by side.
+let widest = 1;
+for (const img of document.querySelectorAll('img[data-width]')) {
+  widest = Math.max(widest, Number(img.dataset.width));
+}
+slider.value = Math.max(1, Math.min(8, Math.floor((window.innerWidth - 80) / (3 * widest))));
+zoom(slider.value);
 )";
 
 void html_figure(std::ostringstream& html, const char* caption, const Image& image) {
@@ -134,9 +141,12 @@ void html_table(std::ostringstream& html, const std::vector<CaseResult>& results
   for (const CaseResult& r : results) {
     const bool compared = r.measures.width > 0;
     html << "<tr><td>" << escaped(r.test->name) << "</td><td class=\""
-         << (r.status == CaseStatus::Passed ? "passed" : "failed") << "\">" << status_name(r.status)
-         << "</td><td>" << (compared ? std::to_string(r.measures.max_diff_srgb8) : "")
-         << "</td><td>" << (compared ? format_number(r.measures.share_over_1) : "") << "</td><td>"
+         << (r.status == CaseStatus::Passed    ? "passed"
+             : r.status == CaseStatus::Skipped ? "skipped"
+                                               : "failed")
+         << "\">" << status_name(r.status) << "</td><td>"
+         << (compared ? std::to_string(r.measures.max_diff_srgb8) : "") << "</td><td>"
+         << (compared ? format_number(r.measures.share_over_1) : "") << "</td><td>"
          << (compared ? format_number(r.measures.rmse_linear) : "") << "</td><td>"
          << (r.status == CaseStatus::Skipped ? escaped(*r.test->skip) : format_number(r.render_ms))
          << "</td></tr>\n";
