@@ -9,6 +9,7 @@
 
 #include <signal.h>
 #include <sys/resource.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -251,4 +252,62 @@ TEST_CASE("image: failed writes leave no file and do not touch the target", "[im
     CHECK_THROWS_AS(covrast::write_png(covrast::Image{}, dir / "empty.png"), covrast::InputError);
     CHECK(names_in(dir.path()).empty());
   }
+}
+
+TEST_CASE("image: read_png checks the header's size before allocating", "[image]") {
+  TempDir dir;
+  // A valid 1x1 PNG whose IHDR is rewritten to claim 12000x12000 (within the side limit,
+  // over the pixel limit) and 20000x1 (over the side limit), with the chunk CRC fixed up.
+  covrast::write_png(noise_image(1, 1), dir / "one.png");
+  const std::string one = read_bytes(dir / "one.png");
+  const auto forged = [&](std::uint32_t width, std::uint32_t height) {
+    std::string png = one;
+    for (int k = 0; k < 4; ++k) {
+      png[16 + k] = char(width >> (24 - 8 * k));
+      png[20 + k] = char(height >> (24 - 8 * k));
+    }
+    // CRC-32 of "IHDR" and its 13 bytes (PNG's polynomial), big-endian after them.
+    std::uint32_t crc = 0xFFFFFFFFu;
+    for (int i = 12; i < 29; ++i) {
+      crc ^= std::uint8_t(png[std::size_t(i)]);
+      for (int b = 0; b < 8; ++b) crc = (crc & 1u) ? 0xEDB88320u ^ (crc >> 1) : crc >> 1;
+    }
+    crc ^= 0xFFFFFFFFu;
+    for (int k = 0; k < 4; ++k) png[29 + k] = char(crc >> (24 - 8 * k));
+    return png;
+  };
+  write_bytes(dir / "big.png", forged(12000, 12000));
+  CHECK_THROWS_WITH(covrast::read_png(dir / "big.png"),
+                    Catch::Contains("12000x12000 is more than the 67108864 pixels"));
+  write_bytes(dir / "wide.png", forged(20000, 1));
+  CHECK_THROWS_AS(covrast::read_png(dir / "wide.png"), covrast::InputError);
+  // A FIFO is refused, not opened (opening one would block).
+  REQUIRE(::mkfifo((dir / "fifo.png").c_str(), 0600) == 0);
+  CHECK_THROWS_WITH(covrast::read_png(dir / "fifo.png"),
+                    (dir / "fifo.png").string() + ": cannot read PNG: not a regular file");
+}
+
+TEST_CASE("image: PNG text records round trip and are checked", "[image]") {
+  TempDir dir;
+  const covrast::Image image = noise_image(8, 4);
+  covrast::write_png(image, dir / "t.png",
+                     {{"covrast", R"({"mode":"coverage"})"}, {"Comment", "two\nlines"}});
+  const std::vector<covrast::PngText> text = covrast::read_png_text(dir / "t.png");
+  REQUIRE(text.size() == 2);
+  CHECK(text[0].keyword == "covrast");
+  CHECK(text[0].text == R"({"mode":"coverage"})");
+  CHECK(text[1].text == "two\nlines");
+  CHECK(covrast::read_png(dir / "t.png").rgb == image.rgb);  // the pixels are unaffected
+  // The same PNG as encode_png gives in memory.
+  CHECK(read_bytes(dir / "t.png") == [&] {
+    const auto bytes = covrast::encode_png(
+        image, {{"covrast", R"({"mode":"coverage"})"}, {"Comment", "two\nlines"}});
+    return std::string(bytes.begin(), bytes.end());
+  }());
+  CHECK_THROWS(covrast::write_png(image, dir / "bad.png", {{"", "empty keyword"}}));
+  CHECK_THROWS(covrast::write_png(image, dir / "bad.png", {{"k", std::string("nul\0", 4)}}));
+  CHECK_FALSE(fs::exists(dir / "bad.png"));
+  CHECK(covrast::read_png_text(dir / "t.png").size() == 2);
+  write_bytes(dir / "text.png", "not a png");
+  CHECK_THROWS_AS(covrast::read_png_text(dir / "text.png"), covrast::InputError);
 }

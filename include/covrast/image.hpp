@@ -49,7 +49,16 @@ std::vector<PngText> read_png_text(const std::filesystem::path& path);
 /// Writes depth as 16-bit greyscale PNG (.png) or as a little-endian PFM (.pfm), atomically.
 void write_depth(const DepthImage& depth, const std::filesystem::path& path);
 
-/// Reads an 8-bit PNG (grey, grey+alpha, RGB or RGBA; alpha dropped). Throws InputError.
+/// The largest PNG read_png reads: each side at most kMaxPngSide, at most kMaxPngPixels in
+/// all (a 8192x8192 image; 192 MiB as RGB), chunks of at most kMaxPngChunkBytes. Checked
+/// from the header before anything is allocated.
+inline constexpr int kMaxPngSide = 16384;
+inline constexpr std::uint64_t kMaxPngPixels = std::uint64_t(1) << 26;
+inline constexpr std::size_t kMaxPngChunkBytes = std::size_t(1) << 26;
+
+/// Reads a PNG of any colour type and bit depth as 8-bit RGB (grey expanded, palette looked
+/// up, alpha dropped, 16-bit samples reduced to their high byte). Throws InputError naming
+/// the file and the problem, also for files over the limits above or not regular files.
 Image read_png(const std::filesystem::path& path);
 
 }  // namespace covrast

@@ -168,6 +168,29 @@ struct Scene {
 /// problem (with line and column for malformed JSON).
 Scene load_scene(const std::filesystem::path& json_path);
 
+/// Mesh files that load_scene has loaded, kept for later scenes that use the same files: a
+/// program that loads many scenes (covrast test) then reads and parses each file once. Files
+/// are known by their canonical path; a file changed on disk in between is not read again.
+/// Not thread-safe: one load_scene at a time per cache.
+class MeshFileCache {
+ public:
+  MeshFileCache();
+  ~MeshFileCache();
+  MeshFileCache(const MeshFileCache&) = delete;
+  MeshFileCache& operator=(const MeshFileCache&) = delete;
+  /// How many mesh files have been loaded into the cache.
+  std::size_t files_loaded() const;
+
+ private:
+  friend Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files);
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// load_scene, taking the meshes from `mesh_files` and adding the ones it loads. Each scene
+/// gets the warnings of the files it uses, whether loaded now or before.
+Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files);
+
 /// Loads one mesh file (.obj, .gltf, .glb) by itself; used by load_scene and tests.
 /// For glTF the node transforms are baked into the positions and COLOR_0 x
 /// baseColorFactor into colors_linear.

@@ -77,6 +77,7 @@ std::vector<const TestCase*> select_cases(const Manifest& manifest, const TestAr
 std::vector<PlannedCase> plan_cases(const std::vector<const TestCase*>& cases,
                                     const TestArgs& args) {
   std::map<std::filesystem::path, std::shared_ptr<const Scene>> scenes;
+  MeshFileCache mesh_files;  // scenes that share mesh files share the loaded meshes
   std::vector<PlannedCase> plans;
   const int threads_per_case = cases.size() > 1 ? 1 : args.threads;
   for (const TestCase* c : cases) {
@@ -87,7 +88,7 @@ std::vector<PlannedCase> plan_cases(const std::vector<const TestCase*>& cases,
     }
     auto& scene = scenes[c->scene];
     try {
-      if (!scene) scene = std::make_shared<const Scene>(load_scene(c->scene));
+      if (!scene) scene = std::make_shared<const Scene>(load_scene(c->scene, mesh_files));
       plan.options.mode = parse_render_mode(c->mode);
       plan.options.width = c->width;
       plan.options.height = c->height;

@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <map>
+#include <memory>
+#include <set>
 #include <string_view>
 #include <utility>
 
@@ -427,23 +429,48 @@ MeshFileRef mesh_file_ref(const std::string& file, const json& entry, const std:
 
 /// The scene's mesh files, each read and parsed once however many instances name it
 /// (instancing: one load per canonical path and format).
-class MeshCache {
- public:
-  MeshCache(const std::string& file, std::filesystem::path base_dir)
-      : file_(file), base_dir_(std::move(base_dir)) {}
+}  // namespace
 
-  /// The mesh that entry `key` names. On its first use the file is loaded and its warnings
-  /// go to `scene` (the lit ones only when the scene is lit).
+/// The loaded mesh files, by canonical path and format.
+struct MeshFileCache::Impl {
+  std::map<std::pair<std::string, MeshFormat>, CachedMesh> files;
+};
+
+MeshFileCache::MeshFileCache() : impl_(std::make_unique<Impl>()) {}
+MeshFileCache::~MeshFileCache() = default;
+std::size_t MeshFileCache::files_loaded() const { return impl_->files.size(); }
+
+namespace {
+
+/// One scene's view of a MeshFileCache: loads each file on its first use in any scene, and
+/// passes each file's warnings to this scene on its first use here.
+class SceneMeshes {
+ public:
+  SceneMeshes(const std::string& file, std::filesystem::path base_dir,
+              std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files)
+      : file_(file), base_dir_(std::move(base_dir)), files_(files) {}
+
+  /// The mesh that entry `key` names.
   CachedMesh& get(const MeshFileRef& ref, const std::string& key, Scene& scene) {
     const std::filesystem::path full = base_dir_ / std::filesystem::path(ref.relative);
     std::error_code ec;
     const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
     if (ec) fail(file_, key, "cannot open '" + ref.relative + "': " + ec.message());
-    auto cached = cache_.find({canonical.string(), ref.format});
-    if (cached != cache_.end()) return cached->second;
-    CachedMesh loaded_mesh;
-    loaded_mesh.loaded = load(full, ref, key);
-    const detail::LoadedMesh& loaded = loaded_mesh.loaded;
+    const auto id = std::make_pair(canonical.string(), ref.format);
+    auto cached = files_.find(id);
+    if (cached == files_.end()) {
+      CachedMesh loaded_mesh;
+      loaded_mesh.loaded = load(full, ref, key);
+      cached = files_.emplace(id, std::move(loaded_mesh)).first;
+    }
+    if (warned_.insert(id).second) add_warnings(full, cached->second.loaded, scene);
+    return cached->second;
+  }
+
+ private:
+  /// The file's warnings (the lit ones only when the scene is lit), once per scene.
+  static void add_warnings(const std::filesystem::path& full, const detail::LoadedMesh& loaded,
+                           Scene& scene) {
     if (loaded.dropped_nonfinite_triangles > 0) {
       scene.warnings.push_back(full.lexically_normal().string() + ": dropped " +
                                std::to_string(loaded.dropped_nonfinite_triangles) +
@@ -453,11 +480,8 @@ class MeshCache {
     if (scene.lit) {
       for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
     }
-    return cache_.emplace(std::make_pair(canonical.string(), ref.format), std::move(loaded_mesh))
-        .first->second;
   }
 
- private:
   detail::LoadedMesh load(const std::filesystem::path& full, const MeshFileRef& ref,
                           const std::string& key) const {
     std::string bytes;
@@ -472,7 +496,8 @@ class MeshCache {
 
   const std::string& file_;
   std::filesystem::path base_dir_;
-  std::map<std::pair<std::string, MeshFormat>, CachedMesh> cache_;
+  std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files_;
+  std::set<std::pair<std::string, MeshFormat>> warned_;
 };
 
 /// The instance's colour selection: "color" or material.base_color (not both), else the
@@ -520,7 +545,7 @@ void select_color(const SceneReader& reader, const std::string& file, const json
 /// Entry `key` of "meshes": its mesh (loaded through `cache`), colour, model matrix,
 /// materials and normals.
 MeshInstance load_instance(const SceneReader& reader, const std::string& file, const json& value,
-                           const std::string& key, MeshCache& cache, Scene& scene) {
+                           const std::string& key, SceneMeshes& cache, Scene& scene) {
   const json& entry = reader.require_object(value, key);
   const MeshFileRef ref = mesh_file_ref(file, entry, key);
   CachedMesh& cached = cache.get(ref, key, scene);
@@ -562,6 +587,11 @@ std::size_t Scene::triangle_count() const {
 }
 
 Scene load_scene(const std::filesystem::path& json_path) {
+  MeshFileCache meshes;
+  return load_scene(json_path, meshes);
+}
+
+Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
   const std::string file = json_path.string();
   const json root = read_scene_root(json_path, file);
   const SceneReader reader(file);
@@ -581,7 +611,7 @@ Scene load_scene(const std::filesystem::path& json_path) {
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  MeshCache cache(file, json_path.parent_path());
+  SceneMeshes cache(file, json_path.parent_path(), mesh_files.impl_->files);
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string key = "meshes[" + std::to_string(i) + "]";
     scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene));
