@@ -1,7 +1,7 @@
-// Tests of `covrast test` (src/cli/test_*.cpp), the golden-manifest runner, through the built
-// executable: missing goldens fail and --update writes them with a record of what rendered
-// them; a changed golden fails with its measures, JUnit, JSON, artifacts and HTML report; the
-// tolerances; --shard and --filter; and every malformed manifest exits 2 naming the case and
+// Tests of `covrast test` (src/cli/manifest.cpp, golden_*.cpp), the golden-manifest runner, through
+// the built executable: missing goldens fail and --update writes them with a record of what
+// rendered them; a changed golden fails with its measures, JUnit, JSON, artifacts and HTML report;
+// the tolerances; --shard and --filter; and every malformed manifest exits 2 naming the case and
 // field, without writing anything.
 #include <covrast/image.hpp>
 

@@ -16,7 +16,7 @@
 #pragma once
 
 #include <covrast/image.hpp>
-#include <covrast/renderer.hpp>
+#include <covrast/options.hpp>
 
 #include <span>
 #include <vector>

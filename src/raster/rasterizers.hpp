@@ -5,7 +5,7 @@
 
 #include "core/tile_raster.hpp"
 
-#include <covrast/renderer.hpp>
+#include <covrast/options.hpp>
 
 #include <memory>
 

@@ -1,8 +1,8 @@
-// `covrast test`: the reports of a run (test_results.hpp): JUnit XML for CI systems, a JSON
+// `covrast test`: the reports of a run (golden_results.hpp): JUnit XML for CI systems, a JSON
 // summary line, and one self-contained HTML page (images as data: URLs, no external scripts),
 // failures first with golden, actual and heat map side by side and a zoom.
 #include "commands.hpp"
-#include "test_results.hpp"
+#include "golden_results.hpp"
 
 #include <nlohmann/json.hpp>
 

@@ -1,5 +1,5 @@
-// `covrast test`: reading and checking the golden manifest (test_manifest.hpp).
-#include "test_manifest.hpp"
+// `covrast test`: reading and checking the golden manifest (manifest.hpp).
+#include "manifest.hpp"
 
 #include "commands.hpp"
 

@@ -1,7 +1,7 @@
-// `covrast test`: what each case gave, and the reports made from it (test_reports.cpp).
+// `covrast test`: what each case gave, and the reports made from it (golden_reports.cpp).
 #pragma once
 
-#include "test_manifest.hpp"
+#include "manifest.hpp"
 
 #include <covrast/compare.hpp>
 #include <covrast/image.hpp>

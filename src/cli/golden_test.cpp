@@ -1,4 +1,4 @@
-// `covrast test MANIFEST`: renders every case of a golden manifest (test_manifest.hpp) in one
+// `covrast test MANIFEST`: renders every case of a golden manifest (manifest.hpp) in one
 // process, compares each with its golden image within the case's tolerance, and reports:
 // text on stdout, optionally JUnit XML, a JSON summary, an HTML page and the failing cases'
 // actual and difference images. --update blesses: it writes the goldens of failing and
@@ -7,8 +7,8 @@
 // Exit codes: 0 every case passed or was skipped (or --update wrote what was needed),
 // 1 a case failed (a missing golden too), 2 a bad manifest, scene or option.
 #include "commands.hpp"
-#include "test_manifest.hpp"
-#include "test_results.hpp"
+#include "manifest.hpp"
+#include "golden_results.hpp"
 
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
