@@ -258,21 +258,7 @@ TEST_CASE("fxaa: the search presets are FXAA 3.11's", "[fxaa]") {
 
 namespace {
 
-/// The camera maps the plane z = 0 one unit to one pixel (as in test_pipeline.cpp):
-/// x_px = x + w/2, y_px = h/2 - y.
-Scene pixel_scene(int width_px, int height_px) {
-  Scene scene;
-  scene.width = width_px;
-  scene.height = height_px;
-  scene.background_linear = glm::vec3(0.0f);
-  scene.camera.eye = glm::dvec3(0.0, 0.0, height_px / 2.0);
-  scene.camera.target = glm::dvec3(0.0);
-  scene.camera.up = glm::dvec3(0.0, 1.0, 0.0);
-  scene.camera.fovy_deg = 90.0;
-  scene.camera.near = 1.0;
-  scene.camera.far = 8.0 * height_px;
-  return scene;
-}
+using covrast::test::pixel_scene;
 
 void add_mesh(Scene& scene, std::vector<glm::vec3> positions, std::vector<std::uint32_t> indices,
               ColorSource source, std::vector<glm::vec3> colours = {}) {

@@ -10,6 +10,22 @@
 
 namespace covrast::test {
 
+/// The camera that maps the world plane z = 0 one unit to one pixel: x_px = x + w/2,
+/// y_px = h/2 - y (a 90-degree field of view at distance h/2), on a black background.
+inline Scene pixel_scene(int width_px, int height_px) {
+  Scene scene;
+  scene.width = width_px;
+  scene.height = height_px;
+  scene.background_linear = glm::vec3(0.0f);
+  scene.camera.eye = glm::dvec3(0.0, 0.0, height_px / 2.0);
+  scene.camera.target = glm::dvec3(0.0);
+  scene.camera.up = glm::dvec3(0.0, 1.0, 0.0);
+  scene.camera.fovy_deg = 90.0;
+  scene.camera.near = 1.0;
+  scene.camera.far = 8.0 * height_px;
+  return scene;
+}
+
 /// Closed UV sphere of radius 1 at the origin, poles on y: `rings` bands from pole to pole,
 /// `segments` around. Single-vertex poles with triangle fans, and the seam reuses segment 0,
 /// so every edge is shared by exactly two triangles; outward faces counter-clockwise.

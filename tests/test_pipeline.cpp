@@ -11,6 +11,8 @@
 #include <covrast/scene.hpp>
 
 #include <catch2/catch.hpp>
+
+#include "test_meshes.hpp"
 #include <glm/gtc/matrix_transform.hpp>
 
 #include <algorithm>
@@ -48,20 +50,7 @@ std::string describe(Rgb c) {
   return s.str();
 }
 
-/// The camera that maps z = 0 one world unit to one pixel (see the top of the file).
-Scene pixel_scene(int width_px, int height_px) {
-  Scene scene;
-  scene.width = width_px;
-  scene.height = height_px;
-  scene.background_linear = glm::vec3(0.0f);
-  scene.camera.eye = glm::dvec3(0.0, 0.0, height_px / 2.0);
-  scene.camera.target = glm::dvec3(0.0);
-  scene.camera.up = glm::dvec3(0.0, 1.0, 0.0);
-  scene.camera.fovy_deg = 90.0;
-  scene.camera.near = 1.0;
-  scene.camera.far = 8.0 * height_px;
-  return scene;
-}
+using covrast::test::pixel_scene;
 
 /// World point on z = 0 of pixel_scene() for pixel coordinates given in 24.8 fixed point.
 glm::vec3 world_of_fx8(const Scene& scene, std::int64_t x_fx8, std::int64_t y_fx8) {
