@@ -48,6 +48,9 @@ constexpr bool valid_tile_px(int tile_px) {
 /// The accepted tile sides in words, for messages and help texts.
 std::string tile_px_rule();
 
+/// Largest RenderOptions::threads [worker threads]; more are refused as bad input.
+inline constexpr int kMaxThreads = 4096;
+
 /// The tuning knobs of FXAA 3.11's quality variant (docs/fxaa.md), with its defaults. Luma is
 /// dot((r, g, b), (0.299, 0.587, 0.114)) of the 8-bit sRGB-encoded colour, in [0, 1].
 struct FxaaOptions {
@@ -68,7 +71,7 @@ struct RenderOptions {
   RenderMode mode;
   int width = 0;    ///< 0: the scene's width
   int height = 0;   ///< 0: the scene's height
-  int threads = 0;  ///< 0: all hardware threads
+  int threads = 0;  ///< 0: all hardware threads; at most kMaxThreads
   int tile = 64;    ///< tile side [pixels], see valid_tile_px
   bool want_depth = false;
   /// Drop the back faces of closed meshes wherever that provably cannot change the image
