@@ -32,8 +32,12 @@ struct RenderMode {
   int samples = 1;  ///< N for ssaa (N x N), K for msaa; 1 otherwise
 };
 
-/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N",
-/// "msaa:K", "reference", "fxaa". Throws InputError listing the accepted forms.
+/// Largest N of the ssaa modes (N x N samples per pixel); N starts at 1.
+inline constexpr int kMaxSsaaSide = 16;
+
+/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N"
+/// (N = 1..kMaxSsaaSide), "msaa:K" (K = 2, 4, 8, 16), "reference", "fxaa". Throws InputError
+/// listing the accepted forms.
 RenderMode parse_render_mode(std::string_view text);
 std::string to_string(const RenderMode& mode);
 

@@ -82,10 +82,12 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
   sub->add_option(
          "--mode", args.mode,
          "Anti-aliasing mode: coverage (exact analytic area, the default), coverage-blend, "
-         "aliased, ssaa:N and ssaa-grid:N (N x N ordered grid, N = 1..16), ssaa-cmj:N (N x N "
-         "correlated multi-jittered), msaa:K (K = 2, 4, 8, 16), reference (double-precision "
-         "ground truth), fxaa (aliased, then the FXAA 3.11 post-process: quality preset 12, "
-         "edge threshold 0.166, edge threshold min 0.0833, subpix 0.75; docs/fxaa.md)")
+         "aliased, ssaa:N and ssaa-grid:N (N x N ordered grid, N = 1.." +
+             std::to_string(kMaxSsaaSide) +
+             "), ssaa-cmj:N (N x N correlated multi-jittered), msaa:K (K = 2, 4, 8, 16), "
+             "reference (double-precision ground truth), fxaa (aliased, then the FXAA 3.11 "
+             "post-process: quality preset 12, edge threshold 0.166, edge threshold min 0.0833, "
+             "subpix 0.75; docs/fxaa.md)")
       ->capture_default_str()
       ->type_name("MODE");
   sub->add_option(
