@@ -25,8 +25,12 @@ struct RenderMode {
   int samples = 1;  ///< N for ssaa (N x N), K for msaa; 1 otherwise
 };
 
-/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N",
-/// "msaa:K", "reference", "fxaa". Throws InputError listing the accepted forms.
+/// Largest N of the ssaa modes (N x N samples per pixel); N starts at 1.
+inline constexpr int kMaxSsaaSide = 16;
+
+/// Parses "aliased", "coverage", "coverage-blend", "ssaa:N", "ssaa-grid:N", "ssaa-cmj:N"
+/// (N = 1..kMaxSsaaSide), "msaa:K" (K = 2, 4, 8, 16), "reference", "fxaa". Throws InputError
+/// listing the accepted forms.
 RenderMode parse_render_mode(std::string_view text);
 std::string to_string(const RenderMode& mode);
 
@@ -40,6 +44,9 @@ constexpr bool valid_tile_px(int tile_px) {
 }
 /// The accepted tile sides in words, for messages and help texts.
 std::string tile_px_rule();
+
+/// Largest RenderOptions::threads [worker threads]; more are refused as bad input.
+inline constexpr int kMaxThreads = 4096;
 
 /// The tuning knobs of FXAA 3.11's quality variant (docs/fxaa.md), with its defaults. Luma is
 /// dot((r, g, b), (0.299, 0.587, 0.114)) of the 8-bit sRGB-encoded colour, in [0, 1].
@@ -59,7 +66,7 @@ struct RenderOptions {
   RenderMode mode;
   int width = 0;    ///< 0: the scene's width
   int height = 0;   ///< 0: the scene's height
-  int threads = 0;  ///< 0: all hardware threads
+  int threads = 0;  ///< 0: all hardware threads; at most kMaxThreads
   int tile = 64;    ///< tile side [pixels], see valid_tile_px
   bool want_depth = false;
   /// Drop the back faces of closed meshes wherever that provably cannot change the image

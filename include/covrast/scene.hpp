@@ -1,4 +1,5 @@
-// covrast public API: the scene, as loaded from a JSON scene file (see docs/scene-format.md).
+// covrast public API: the scene, as loaded from a JSON scene file (see docs/scene-format.md)
+// or built in code (make_mesh, add_instance, add_light).
 // Loading is the first stage of the pipeline: scene -> geometry -> binning -> raster ->
 // resolve -> image. Everything here is in world units and linear-light colour; nothing
 // here knows about pixels except the requested image size.
@@ -11,6 +12,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -195,6 +197,81 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 /// For glTF the node transforms are baked into the positions and COLOR_0 x
 /// baseColorFactor into colors_linear.
 std::shared_ptr<MeshData> load_mesh(const std::filesystem::path& path);
+
+// Building a scene in code (no files): what load_scene does for a scene file's entries,
+// with the same checks, for programs and C++ test suites. A typical use:
+//   Scene scene;  // set width, height, camera, background_linear
+//   auto quad = make_mesh({.positions = {...}, .indices = {0, 1, 2, 0, 2, 3}});
+//   add_instance(scene, quad, {.color_srgb = glm::vec3(1.0f, 0.2f, 0.0f)});
+//   check_scene(scene);
+//   Image image = render(scene, {}).color;  (covrast/renderer.hpp)
+
+/// A mesh's arrays, as an OBJ file with "v x y z r g b", "vn" and "f" lines would give them.
+/// Every member of MeshArrays and InstanceDesc has an initializer, so that a designated
+/// initializer may leave any of them out (g++ 12 -Wextra warns otherwise).
+struct MeshArrays {
+  std::string name = "mesh";  ///< MeshData::source, the prefix of every error message
+  /// Object space [world units], each coordinate finite.
+  std::vector<glm::vec3> positions{};
+  /// 3 per triangle, each < positions.size(); counter-clockwise seen from the front.
+  std::vector<std::uint32_t> indices{};
+  /// Optional vertex colours: one per position, sRGB display values, each in 0..1.
+  std::vector<glm::vec3> colors_srgb{};
+  /// Optional normals: 3 per triangle in index order, finite; a zero vector means "use the
+  /// face normal here" (MeshData::corner_normals).
+  std::vector<glm::vec3> corner_normals{};
+  /// Optional materials and each triangle's index into them (MeshData::materials and
+  /// triangle_materials; checked like a scene file's "material": metallic and roughness in
+  /// 0..1, shininess in 0.001..10000, colours finite and >= 0).
+  std::vector<Material> materials{};
+  std::vector<std::uint32_t>
+      triangle_materials{};  ///< empty or one per triangle, < materials.size()
+};
+
+/// A MeshData from arrays, checked and analysed the way load_mesh does it (colours to linear
+/// light, analyze_mesh_topology for back-face culling). Share the result between instances.
+/// Throws InputError ("NAME: problem") for: indices not a multiple of 3, an index out of
+/// range, a non-finite coordinate or normal, a colour outside 0..1, array sizes that do not
+/// match, a bad material or material index. (A file's NaN vertices drop their triangles with
+/// a warning; here they are refused, since the caller can fix them.)
+std::shared_ptr<const MeshData> make_mesh(MeshArrays arrays);
+
+/// How add_instance places and colours a mesh: the keys of a scene file's "meshes" entry.
+struct InstanceDesc {
+  /// Object -> world (GLM is column-major: translation in model[3]); finite and affine (last
+  /// row 0, 0, 0, 1).
+  glm::dmat4 model{1.0};
+  /// Uniform colour, sRGB display values in 0..1 ("color": [r,g,b]). Unset: the mesh's vertex
+  /// colours when it has them, else white.
+  std::optional<glm::vec3> color_srgb{};
+  /// "color": "per_triangle", the debug colouring (color_srgb must then be unset).
+  bool per_triangle_colors = false;
+  /// Lit scenes: the material of every triangle. Unset: the mesh's materials, or one Lambert
+  /// material when it has none (as for an OBJ file).
+  std::optional<Material> material{};
+  /// Unset: File when the mesh has corner normals, else Flat. File for a mesh without
+  /// normals is an error.
+  std::optional<NormalSource> normals{};
+};
+
+/// Appends an instance of `mesh` to scene.meshes, filled as load_scene fills one (colour to
+/// linear light, materials, normals; Smooth normals are computed here, once per call), and
+/// returns it. Throws InputError for a null mesh or a bad InstanceDesc.
+MeshInstance& add_instance(Scene& scene, std::shared_ptr<const MeshData> mesh,
+                           const InstanceDesc& desc = {});
+
+/// Appends a light and makes the scene lit (Scene::lit), as a scene file's "lights" entry:
+/// the direction (directional, spot) must be non-zero and is normalised here; colour and
+/// intensity finite and >= 0; range 0 (infinite) or > 0; 0 <= inner < outer <= 90 degrees.
+/// Throws InputError otherwise.
+void add_light(Scene& scene, Light light);
+
+/// Checks what load_scene would have refused in a scene built in code: the size (1..
+/// kMaxImageSide), the camera (Camera's comments; eye != target, up not parallel to the view
+/// direction), a background in 0..1, and each instance (a mesh, indices in range, array sizes
+/// that match, a finite affine model matrix, one material per mesh material). Throws
+/// InputError naming the first problem. O(triangles); the renderer does not call it.
+void check_scene(const Scene& scene);
 
 /// The per_triangle debug colour: h = lowbias32(index), r = (h & 255) / 255, g = (h >> 8 &
 /// 255) / 255, b = (h >> 16 & 255) / 255, as sRGB display values.

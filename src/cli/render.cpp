@@ -24,7 +24,7 @@
 namespace covrast::cli {
 namespace {
 
-constexpr int kMaxThreads = 4096;
+/// --repeat's bound: a timing aid, not a property of the renderer, so it is the CLI's own.
 constexpr int kMaxRepeat = 1000;
 
 /// Median of the per-frame values of one timing field; mean of the middle two for even K.
@@ -82,17 +82,21 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
   sub->add_option(
          "--mode", args.mode,
          "Anti-aliasing mode: coverage (exact analytic area, the default), coverage-blend, "
-         "aliased, ssaa:N and ssaa-grid:N (N x N ordered grid, N = 1..16), ssaa-cmj:N (N x N "
-         "correlated multi-jittered), msaa:K (K = 2, 4, 8, 16), reference (double-precision "
-         "ground truth), fxaa (aliased, then the FXAA 3.11 post-process: quality preset 12, "
-         "edge threshold 0.166, edge threshold min 0.0833, subpix 0.75; docs/fxaa.md)")
+         "aliased, ssaa:N and ssaa-grid:N (N x N ordered grid, N = 1.." +
+             std::to_string(kMaxSsaaSide) +
+             "), ssaa-cmj:N (N x N correlated multi-jittered), msaa:K (K = 2, 4, 8, 16), "
+             "reference (double-precision ground truth), fxaa (aliased, then the FXAA 3.11 "
+             "post-process: quality preset 12, edge threshold 0.166, edge threshold min 0.0833, "
+             "subpix 0.75; docs/fxaa.md)")
       ->capture_default_str()
       ->type_name("MODE");
   sub->add_option(
          "--size", args.size,
          "Image size, overriding the scene's (each side 1.." + std::to_string(kMaxImageSide) + ")")
       ->type_name("WxH");
-  sub->add_option("--threads", args.threads, "Worker threads; 0 = all hardware threads")
+  sub->add_option(
+         "--threads", args.threads,
+         "Worker threads; 0 = all hardware threads (at most " + std::to_string(kMaxThreads) + ")")
       ->check(CLI::Range(0, kMaxThreads))
       ->capture_default_str()
       ->type_name("N");
@@ -117,8 +121,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->type_name("DEPTH.png|.pfm");
   sub->add_flag("--stats", args.stats,
                 "Print one JSON line of statistics (counts, median stage times) to stdout");
-  sub->add_option("--repeat", args.repeat,
-                  "Render K frames and report the median frame time (1..1000)")
+  sub->add_option(
+         "--repeat", args.repeat,
+         "Render K frames and report the median frame time (1.." + std::to_string(kMaxRepeat) + ")")
       ->check(CLI::Range(1, kMaxRepeat))
       ->capture_default_str()
       ->type_name("K");

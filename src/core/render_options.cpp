@@ -12,7 +12,8 @@ RenderMode parse_render_mode(std::string_view text) {
   auto fail = [&]() -> RenderMode {
     throw InputError("unknown mode '" + std::string(text) +
                      "': expected aliased, coverage, coverage-blend, ssaa:N, ssaa-grid:N or "
-                     "ssaa-cmj:N (N = 1..16), msaa:K (K = 2, 4, 8, 16), reference or fxaa");
+                     "ssaa-cmj:N (N = 1.." +
+                     std::to_string(kMaxSsaaSide) + "), msaa:K (K = 2, 4, 8, 16), reference or fxaa");
   };
   if (text == "aliased") return {ModeKind::Aliased, 1};
   if (text == "fxaa") return {ModeKind::Fxaa, 1};
@@ -26,7 +27,7 @@ RenderMode parse_render_mode(std::string_view text) {
   auto [end, ec] = std::from_chars(number.data(), number.data() + number.size(), n);
   if (ec != std::errc() || end != number.data() + number.size()) return fail();
   if (name == "ssaa" || name == "ssaa-grid" || name == "ssaa-cmj") {
-    if (n < 1 || n > 16) return fail();
+    if (n < 1 || n > kMaxSsaaSide) return fail();
     const ModeKind kind = name == "ssaa"        ? ModeKind::Ssaa
                           : name == "ssaa-grid" ? ModeKind::SsaaGrid
                                                 : ModeKind::SsaaCmj;

@@ -278,7 +278,11 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
     throw InputError("tile size " + std::to_string(options.tile) + " out of range: must be " +
                      tile_px_rule());
   }
-  if (options.threads < 0) throw InputError("thread count must be >= 0 (0 = all cores)");
+  if (options.threads < 0 || options.threads > kMaxThreads) {
+    throw InputError("thread count " + std::to_string(options.threads) +
+                     " out of range: must be 0.." + std::to_string(kMaxThreads) +
+                     " (0 = all cores)");
+  }
   int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
   // Fail early on modes that cannot be built.
   detail::make_tile_rasterizer(options.mode, options.tile);
