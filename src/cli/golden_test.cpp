@@ -7,8 +7,8 @@
 // Exit codes: 0 every case passed or was skipped (or --update wrote what was needed),
 // 1 a case failed (a missing golden too), 2 a bad manifest, scene or option.
 #include "commands.hpp"
-#include "manifest.hpp"
 #include "golden_results.hpp"
+#include "manifest.hpp"
 
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
@@ -16,17 +16,15 @@
 
 #include <unistd.h>
 
-#include <tbb/global_control.h>
-#include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
 
-#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <map>
 #include <memory>
 #include <mutex>
+#include <stdexcept>
 
 namespace covrast::cli {
 namespace {
@@ -192,20 +190,16 @@ std::vector<CaseResult> run_cases(const std::vector<PlannedCase>& plans, const T
   Progress progress(plans.size(), !args.quiet);
   // The cases run in parallel, one thread each (a lone case takes every thread): small CI
   // images keep a thread busier as a whole case than as a few tiles.
-  std::atomic<bool> failed{false};
-  std::string error;
-  std::mutex error_mutex;
-  tbb::parallel_for(std::size_t(0), plans.size(), [&](std::size_t i) {
-    if (failed) return;
+  for_each_in_parallel(plans.size(), args.threads, [&](std::size_t i) {
     try {
       results[i] = run_case(plans[i], build);
+    } catch (const InputError& e) {
+      throw InputError("case '" + plans[i].test->name + "': " + e.what());
     } catch (const std::exception& e) {
-      const std::lock_guard<std::mutex> lock(error_mutex);
-      if (!failed.exchange(true)) error = "case '" + plans[i].test->name + "': " + e.what();
+      throw std::runtime_error("case '" + plans[i].test->name + "': " + e.what());
     }
     progress.done_one();
   });
-  if (failed) throw InputError(error);
   return results;
 }
 
@@ -308,11 +302,6 @@ int run_test(TestArgs args) {
   const Clock::time_point start = Clock::now();
   const Manifest manifest = load_manifest(args.manifest);
   const std::vector<PlannedCase> plans = plan_cases(select_cases(manifest, args), args);
-  std::unique_ptr<tbb::global_control> limit;
-  if (args.threads > 0) {
-    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism,
-                                                  std::size_t(args.threads));
-  }
   std::vector<CaseResult> results = run_cases(plans, args);
   if (args.update) update_goldens(plans, results, args);
   const RunSummary summary = summarize(results, start);
