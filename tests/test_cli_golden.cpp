@@ -210,4 +210,8 @@ TEST_CASE("covrast test: malformed manifests exit 2 naming the case and field", 
   expect_error(R"({"cases": [)", "malformed manifest JSON");
   expect_error(head + "}]}", "--shard", {"--shard", "4/3"});
   expect_error(head + "}]}", "--all goes with --update", {"--all"});
+  const RunResult missing = w.run({"no-such-manifest.json"});
+  CHECK(missing.exit_code == 2);
+  CHECK(missing.err ==
+        "covrast: error: no-such-manifest.json: cannot read manifest: no such file\n");
 }

@@ -289,7 +289,8 @@ CLI::App* add_test_command(CLI::App& app, TestArgs& args) {
   sub->add_option("--filter", args.filter, "Only the cases whose name matches GLOB (*, ?, [])")
       ->type_name("GLOB");
   sub->add_option("--threads", args.threads, "Worker threads (0 = all cores)")
-      ->check(CLI::Range(0, kMaxThreads));
+      ->check(CLI::Range(0, kMaxThreads))
+      ->type_name("N");
   sub->add_flag("--strict", args.strict, "Treat scene warnings as errors (exit 2)");
   sub->add_flag("--quiet", args.quiet, "No progress and no warnings on stderr");
   return sub;

@@ -36,7 +36,11 @@ struct Where {
 
 Json read_json(const std::filesystem::path& path) {
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
+  const auto status = std::filesystem::status(path, ec);
+  if (!std::filesystem::exists(status)) {
+    throw InputError(path.string() + ": cannot read manifest: no such file");
+  }
+  if (!std::filesystem::is_regular_file(status)) {
     throw InputError(path.string() + ": cannot read manifest: not a regular file");
   }
   if (std::filesystem::file_size(path, ec) > kMaxManifestBytes) {
