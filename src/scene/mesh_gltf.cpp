@@ -1,7 +1,8 @@
 // glTF 2.0 reader (.gltf with embedded or external buffers, .glb) on top of tinygltf. Collects
-// every mode-TRIANGLES primitive of every mesh reachable from the default scene (scene 0 when
-// none is marked, every root node when the file has no scene at all), bakes the node transforms
-// (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into colors_linear.
+// every triangle primitive (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN) of every mesh reachable
+// from the default scene (scene 0 when none is marked, every root node when the file has no
+// scene at all), bakes the node transforms (matrix, or T * R * S) into the positions, and
+// COLOR_0 x baseColorFactor into colors_linear; points and lines are counted in a warning.
 // glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
 // bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
 #include "scene/scene_internal.hpp"
@@ -9,6 +10,7 @@
 #include <tiny_gltf.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <climits>
 #include <cmath>
@@ -459,6 +461,9 @@ class GltfMeshBuilder {
 
   LoadedMesh finish() {
     LoadedMesh loaded;
+    if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
+      loaded.warnings.push_back(undrawn);
+    }
     if (emissive_textures_ > 0) {
       loaded.lit_warnings.push_back(name_ + ": " + std::to_string(emissive_textures_) +
                                     " materials with an emissive texture: textures are not "
@@ -478,7 +483,8 @@ class GltfMeshBuilder {
   }
 
  private:
-  /// Mesh `mesh_index` of node `node_index`, with the node's world transform.
+  /// Mesh `mesh_index` of node `node_index`, with the node's world transform. Primitives of
+  /// the point and line modes are counted (LoadedMesh::warnings), not drawn.
   void add_mesh(int node_index, int mesh_index, const glm::dmat4& world) {
     if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size()) {
       fail(name_, "node " + std::to_string(node_index) + ": mesh " + std::to_string(mesh_index) +
@@ -487,16 +493,23 @@ class GltfMeshBuilder {
     const tinygltf::Mesh& gltf_mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
     for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = gltf_mesh.primitives[p];
+      const std::string what =
+          "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
       const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
-      if (mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips, fans: not drawn
-      add_primitive(primitive,
-                    "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p),
-                    world);
+      if (mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+        fail(name_, what + ": unknown mode " + std::to_string(mode) + " (glTF has 0..6)");
+      }
+      if (mode < TINYGLTF_MODE_TRIANGLES) {
+        ++undrawn_primitives_[static_cast<std::size_t>(mode)];
+        continue;
+      }
+      add_primitive(primitive, mode, what, world);
     }
   }
 
-  /// One mode-TRIANGLES primitive; `what` names it in messages.
-  void add_primitive(const tinygltf::Primitive& primitive, const std::string& what,
+  /// One primitive of a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN); `what`
+  /// names it in messages.
+  void add_primitive(const tinygltf::Primitive& primitive, int mode, const std::string& what,
                      const glm::dmat4& world) {
     const auto position_it = primitive.attributes.find("POSITION");
     if (position_it == primitive.attributes.end()) fail(name_, what + ": no POSITION attribute");
@@ -527,7 +540,9 @@ class GltfMeshBuilder {
     add_colors(primitive, what, vertex_count, factor, factor_clamped);
 
     const std::size_t first_index = mesh_->indices.size();
-    add_indices(primitive, what, vertex_count, base);
+    add_triangles(triangle_corners(mode, vertex_sequence(primitive, what, vertex_count),
+                                   primitive.indices >= 0, what),
+                  base);
     // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
     // clockwise; swapping two corners keeps counter-clockwise = front after baking.
     if (glm::determinant(glm::dmat3(world)) < 0.0) {
@@ -584,19 +599,15 @@ class GltfMeshBuilder {
     }
   }
 
-  /// The primitive's triangles as mesh indices (its vertices start at `base`): its index
-  /// accessor, or consecutive vertices when it has none.
-  void add_indices(const tinygltf::Primitive& primitive, const std::string& what,
-                   std::size_t vertex_count, std::size_t base) {
+  /// The primitive's vertex sequence: its index accessor, or 0, 1, ... when it has none.
+  std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& primitive,
+                                             const std::string& what,
+                                             std::size_t vertex_count) const {
+    std::vector<std::uint32_t> sequence;
     if (primitive.indices < 0) {
-      if (vertex_count % 3 != 0) {
-        fail(name_,
-             what + ": vertex count " + std::to_string(vertex_count) + " is not a multiple of 3");
-      }
-      for (std::size_t v = 0; v < vertex_count; ++v) {
-        mesh_->indices.push_back(static_cast<std::uint32_t>(base + v));
-      }
-      return;
+      sequence.resize(vertex_count);
+      for (std::size_t v = 0; v < vertex_count; ++v) sequence[v] = static_cast<std::uint32_t>(v);
+      return sequence;
     }
     int index_components = 0;
     const std::vector<double> indices =
@@ -608,16 +619,60 @@ class GltfMeshBuilder {
                                   index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
       fail(name_, what + ": indices must be unsigned byte, short or int scalars");
     }
-    if (indices.size() % 3 != 0) {
-      fail(name_,
-           what + ": index count " + std::to_string(indices.size()) + " is not a multiple of 3");
-    }
     for (const double index : indices) {
       if (index >= static_cast<double>(vertex_count)) {
         fail(name_, what + ": index " + std::to_string(static_cast<std::uint64_t>(index)) +
                         " out of range (" + std::to_string(vertex_count) + " vertices)");
       }
-      mesh_->indices.push_back(static_cast<std::uint32_t>(base + static_cast<std::size_t>(index)));
+      sequence.push_back(static_cast<std::uint32_t>(index));
+    }
+    return sequence;
+  }
+
+  /// The corners of the triangles that `mode` makes of `sequence`, 3 per triangle (glTF 2.0
+  /// spec, 3.7.2.1): TRIANGLES takes them three by three; TRIANGLE_STRIP makes triangle i
+  /// (v_i, v_{i+1+i%2}, v_{i+2-i%2}), so every other one is turned to keep the winding;
+  /// TRIANGLE_FAN makes (v_{i+1}, v_{i+2}, v_0).
+  ///
+  ///   strip  1---3---5        fan   2---1
+  ///         / \ / \ /              |  /|
+  ///        0---2---4                | / |
+  ///                                 |/  |
+  ///                                 0---4 ... around v_0
+  /// `indexed`: the sequence comes from an index accessor (for messages).
+  std::vector<std::uint32_t> triangle_corners(int mode, std::vector<std::uint32_t> sequence,
+                                              bool indexed, const std::string& what) const {
+    const std::size_t n = sequence.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (n % 3 != 0) {
+        fail(name_, what + (indexed ? ": index count " : ": vertex count ") + std::to_string(n) +
+                        " is not a multiple of 3");
+      }
+      return sequence;
+    }
+    const char* const mode_name =
+        mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN";
+    if (n < 3) {
+      fail(name_, what + ": " + mode_name + " needs at least 3 vertices, got " + std::to_string(n));
+    }
+    std::vector<std::uint32_t> corners;
+    corners.reserve(3 * (n - 2));
+    for (std::size_t i = 0; i + 2 < n; ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        corners.insert(corners.end(),
+                       {sequence[i], sequence[i + 1 + i % 2], sequence[i + 2 - i % 2]});
+      } else {
+        corners.insert(corners.end(), {sequence[i + 1], sequence[i + 2], sequence[0]});
+      }
+    }
+    return corners;
+  }
+
+  /// Appends triangle corners (primitive vertex numbers) as mesh indices; the primitive's
+  /// vertices start at `base`.
+  void add_triangles(const std::vector<std::uint32_t>& corners, std::size_t base) {
+    for (const std::uint32_t corner : corners) {
+      mesh_->indices.push_back(static_cast<std::uint32_t>(base + corner));
     }
   }
 
@@ -637,6 +692,23 @@ class GltfMeshBuilder {
     }
   }
 
+  /// "name: 3 primitives not drawn (POINTS 1, LINES 2): covrast draws triangles only", or
+  /// empty when every primitive was a triangle one.
+  std::string undrawn_primitives_message() const {
+    static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    std::size_t total = 0;
+    std::string counts;
+    for (std::size_t mode = 0; mode < undrawn_primitives_.size(); ++mode) {
+      if (undrawn_primitives_[mode] == 0) continue;
+      total += undrawn_primitives_[mode];
+      counts += (counts.empty() ? "" : ", ") + std::string(kModeNames[mode]) + " " +
+                std::to_string(undrawn_primitives_[mode]);
+    }
+    if (total == 0) return {};
+    return name_ + ": " + std::to_string(total) + " primitives not drawn (" + counts +
+           "): covrast draws triangles only";
+  }
+
   const tinygltf::Model& model_;
   const std::string& name_;
   const Reader reader_;
@@ -644,6 +716,9 @@ class GltfMeshBuilder {
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
+  /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per
+  /// node that uses them.
+  std::array<std::size_t, 4> undrawn_primitives_{};
   std::vector<glm::vec3> colors_;  ///< per vertex: COLOR_0 x factor, or the factor alone
   bool any_color_attribute_ = false;
   bool any_primitive_ = false;

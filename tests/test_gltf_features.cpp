@@ -1,0 +1,161 @@
+// Tests of the glTF features beyond plain triangle lists (src/scene/mesh_gltf.cpp): strips and
+// fans, points and lines counted in a warning. Every file is written here
+// by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
+#include <covrast/error.hpp>
+#include <covrast/renderer.hpp>
+#include <covrast/scene.hpp>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "test_cli_run.hpp"
+#include "test_gltf_files.hpp"
+#include "test_tempdir.hpp"
+
+namespace fs = std::filesystem;
+using Catch::Matchers::Contains;
+using covrast::InputError;
+using covrast::test::GltfBuilder;
+using nlohmann::json;
+
+namespace {
+
+class TempDir : public covrast::test::TempDir {
+ public:
+  TempDir() : covrast::test::TempDir("covrast-test-gltf") {}
+
+  fs::path write(const std::string& name, const std::string& contents) const {
+    const fs::path file = path() / name;
+    std::ofstream out(file, std::ios::binary);
+    out << contents;
+    return file;
+  }
+};
+
+/// A scene of one glTF file, looking down -z at the origin from (0, 0, 3), unlit.
+json scene_of(const std::string& gltf_file) {
+  return {{"width", 32},
+          {"height", 32},
+          {"camera",
+           {{"eye", {0, 0, 3}},
+            {"target", {0, 0, 0}},
+            {"up", {0, 1, 0}},
+            {"fovy_deg", 45.0},
+            {"near", 0.5},
+            {"far", 10.0}}},
+          {"meshes", {{{"gltf", gltf_file}}}}};
+}
+
+/// The z component of (b - a) x (c - a) for every triangle: > 0 for counter-clockwise seen
+/// from +z.
+std::vector<float> winding_z(const covrast::MeshData& mesh) {
+  std::vector<float> z;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    const glm::vec3 a = mesh.positions[mesh.indices[t]];
+    const glm::vec3 b = mesh.positions[mesh.indices[t + 1]];
+    const glm::vec3 c = mesh.positions[mesh.indices[t + 2]];
+    z.push_back(glm::cross(b - a, c - a).z);
+  }
+  return z;
+}
+
+/// A row of 5 vertices zig-zagging along x in the plane z = 0 (0, 2, 4 above, 1, 3 below), so
+/// that the strip's first triangle (0, 1, 2) is counter-clockwise seen from +z.
+std::vector<float> zigzag_positions() {
+  return {-1, 1, 0, -0.5f, -1, 0, 0, 1, 0, 0.5f, -1, 0, 1, 1, 0};
+}
+
+}  // namespace
+
+TEST_CASE("glTF TRIANGLE_STRIP and TRIANGLE_FAN give n - 2 triangles in the spec's order",
+          "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const int positions = b.add_floats(zigzag_positions(), "VEC3");
+  // The fan walks the convex outline 1 3 4 2 0 counter-clockwise around its first vertex.
+  const int fan_indices = b.add_u16({1, 3, 4, 2, 0}, "SCALAR");
+  b.single_mesh(
+      {{{"attributes", {{"POSITION", positions}}}, {"mode", 5}},
+       {{"attributes", {{"POSITION", positions}}}, {"mode", 6}, {"indices", fan_indices}}});
+  const auto mesh = covrast::load_mesh(dir.write("modes.glb", b.glb()));
+  // Strip triangle i: (v_i, v_{i+1+i%2}, v_{i+2-i%2}); fan triangle i: (v_{i+1}, v_{i+2}, v_0),
+  // with the fan's vertices 5..9 after the strip's 0..4.
+  REQUIRE(mesh->indices == std::vector<std::uint32_t>{0, 1, 2, 1, 3, 2, 2, 3, 4,  //
+                                                      8, 9, 6, 9, 7, 6, 7, 5, 6});
+  REQUIRE(mesh->triangle_count() == 6);
+  for (const float z : winding_z(*mesh)) REQUIRE(z > 0.0f);  // all counter-clockwise
+}
+
+TEST_CASE("a glTF strip is drawn: the pixels it covers take the file's colour", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  // A quad [-1, 1]^2 as a 4-vertex strip, red by its material.
+  const int positions = b.add_floats({-1, -1, 0, 1, -1, 0, -1, 1, 0, 1, 1, 0}, "VEC3");
+  b.single_mesh({{{"attributes", {{"POSITION", positions}}}, {"mode", 5}, {"material", 0}}});
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 1}}}}}};
+  dir.write("quad.glb", b.glb());
+  std::ofstream(dir / "scene.json") << scene_of("quad.glb").dump();
+  const covrast::Scene scene = covrast::load_scene(dir / "scene.json");
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode("coverage");
+  options.threads = 1;
+  const covrast::Image image = covrast::render(scene, options).color;
+  // The quad spans +-1 at distance 3 with a 45 degree view: tan(22.5) * 3 = 1.24 > 1, so the
+  // middle 24 x 24 pixels are inside it and the corners outside.
+  for (const auto& [x, y] : {std::pair{16, 16}, std::pair{6, 6}, std::pair{25, 25}}) {
+    const std::uint8_t* p = image.pixel(x, y);
+    REQUIRE(p[0] == 255);
+    REQUIRE(p[1] == 0);
+    REQUIRE(p[2] == 0);
+  }
+  REQUIRE(image.pixel(0, 0)[0] == 0);
+}
+
+TEST_CASE("glTF points and lines are counted in one warning, not drawn", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const int positions = b.add_floats(zigzag_positions(), "VEC3");
+  const json attributes = {{"POSITION", positions}};
+  b.single_mesh({{{"attributes", attributes}, {"mode", 0}},
+                 {{"attributes", attributes}, {"mode", 1}},
+                 {{"attributes", attributes}, {"mode", 1}},
+                 {{"attributes", attributes}, {"mode", 2}},
+                 {{"attributes", attributes}, {"mode", 3}},
+                 {{"attributes", attributes}, {"mode", 5}}});
+  dir.write("lines.glb", b.glb());
+  std::ofstream(dir / "scene.json") << scene_of("lines.glb").dump();
+  const covrast::Scene scene = covrast::load_scene(dir / "scene.json");
+  REQUIRE(scene.triangle_count() == 3);
+  REQUIRE(scene.warnings ==
+          std::vector<std::string>{(dir.path() / "lines.glb").lexically_normal().string() +
+                                   ": 5 primitives not drawn (POINTS 1, LINES 2, LINE_LOOP 1, "
+                                   "LINE_STRIP 1): covrast draws triangles only"});
+  // --strict turns the warning into an error: exit 2, no image.
+  const auto result = covrast::test::run_cli_in(
+      dir.path(), {"render", "scene.json", "-o", "out.png", "--strict"}, true);
+  REQUIRE(result.exit_code == 2);
+  REQUIRE_THAT(result.err, Contains("primitives not drawn"));
+  REQUIRE_FALSE(fs::exists(dir / "out.png"));
+}
+
+TEST_CASE("bad glTF primitive modes are InputErrors naming file and primitive", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const int positions = b.add_floats({0, 0, 0, 1, 0, 0}, "VEC3");
+  b.single_mesh({{{"attributes", {{"POSITION", positions}}}, {"mode", 5}}});
+  REQUIRE_THROWS_WITH(
+      covrast::load_mesh(dir.write("short.glb", b.glb())),
+      Contains("short.glb: mesh 0 primitive 0: TRIANGLE_STRIP needs at least 3 vertices, got 2"));
+  b.gltf["meshes"][0]["primitives"][0]["mode"] = 6;
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("short_fan.glb", b.glb())),
+                      Contains("TRIANGLE_FAN needs at least 3 vertices, got 2"));
+  b.gltf["meshes"][0]["primitives"][0]["mode"] = 7;
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("mode7.glb", b.glb())),
+                      Contains("mode7.glb: mesh 0 primitive 0: unknown mode 7"));
+}
