@@ -1,5 +1,5 @@
 // Tests of the glTF features beyond plain triangle lists (src/scene/mesh_gltf.cpp): strips and
-// fans, points and lines counted in a warning. Every file is written here
+// fans, points and lines counted in a warning, extensionsRequired. Every file is written here
 // by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
@@ -158,4 +158,45 @@ TEST_CASE("bad glTF primitive modes are InputErrors naming file and primitive", 
   b.gltf["meshes"][0]["primitives"][0]["mode"] = 7;
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("mode7.glb", b.glb())),
                       Contains("mode7.glb: mesh 0 primitive 0: unknown mode 7"));
+}
+
+TEST_CASE("a glTF file requiring an extension covrast lacks is an InputError naming it", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const int positions = b.add_floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+  b.single_mesh({{{"attributes", {{"POSITION", positions}}}}});
+  b.gltf["extensionsUsed"] = {"EXT_meshopt_compression", "KHR_materials_unlit"};
+  b.gltf["extensionsRequired"] = {"KHR_materials_unlit", "EXT_meshopt_compression"};
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("meshopt.glb", b.glb())),
+                      Contains("meshopt.glb: requires the glTF extension "
+                               "EXT_meshopt_compression, which covrast does not implement"));
+  std::ofstream(dir / "scene.json") << scene_of("meshopt.glb").dump();
+  const auto result =
+      covrast::test::run_cli_in(dir.path(), {"render", "scene.json", "-o", "out.png"}, true);
+  REQUIRE(result.exit_code == 2);
+  REQUIRE_THAT(result.err, Contains("EXT_meshopt_compression"));
+
+  // Extensions only used, not required, load (and are ignored where covrast lacks them).
+  b.gltf["extensionsRequired"] = {"KHR_materials_unlit"};
+  REQUIRE(covrast::load_mesh(dir.write("unlit.glb", b.glb()))->triangle_count() == 1);
+  b.gltf.erase("extensionsRequired");
+  REQUIRE(covrast::load_mesh(dir.write("used.glb", b.glb()))->triangle_count() == 1);
+}
+
+TEST_CASE("KHR_mesh_quantization: normalized short positions load as v / 32767", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const int positions = b.add_i16({0, 0, 0, 0, 32767, 0, 0, 0, 0, -32767, 0, 0}, "VEC4", true);
+  // VEC4 is not a position type: first the error, then the right VEC3 (padded to 4 bytes per
+  // element by a byteStride of 8).
+  b.single_mesh({{{"attributes", {{"POSITION", positions}}}}});
+  b.gltf["extensionsRequired"] = {"KHR_mesh_quantization"};
+  b.gltf["extensionsUsed"] = {"KHR_mesh_quantization"};
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("vec4.glb", b.glb())),
+                      Contains("POSITION must be VEC3"));
+  b.gltf["accessors"][static_cast<std::size_t>(positions)]["type"] = "VEC3";
+  b.gltf["accessors"][static_cast<std::size_t>(positions)]["count"] = 3;
+  b.gltf["bufferViews"][0]["byteStride"] = 8;
+  const auto mesh = covrast::load_mesh(dir.write("quantized.glb", b.glb()));
+  REQUIRE(mesh->positions == std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {0, -1, 0}});
 }

@@ -16,6 +16,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <string_view>
 #include <vector>
 
 namespace covrast::detail {
@@ -62,6 +63,15 @@ std::string loader_error_message(const std::string& name, std::string text) {
     }
   }
   return out;
+}
+
+/// `text` with every byte outside printable ASCII shown as '?' (messages are one line).
+std::string printable(std::string text) {
+  for (char& c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte >= 0x7f) c = '?';
+  }
+  return text;
 }
 
 int component_size_bytes(int component_type) {
@@ -380,6 +390,24 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                                        static_cast<unsigned>(bytes.size()), base_dir.string());
   if (!ok) throw InputError(loader_error_message(name, err));
   return model;
+}
+
+/// The glTF extensions covrast implements: a file may require these (extensionsRequired).
+/// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
+/// reader takes in every type anyway.
+constexpr std::array<std::string_view, 3> kImplementedExtensions = {
+    "KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_mesh_quantization"};
+
+/// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
+/// load, since drawing it without would be wrong.
+void check_required_extensions(const tinygltf::Model& model, const std::string& name) {
+  for (const std::string& extension : model.extensionsRequired) {
+    if (std::find(kImplementedExtensions.begin(), kImplementedExtensions.end(), extension) ==
+        kImplementedExtensions.end()) {
+      fail(name, "requires the glTF extension " + printable(extension) +
+                     ", which covrast does not implement");
+    }
+  }
 }
 
 /// Where the node walk starts: the chosen scene's nodes, or every node that is nobody's child
@@ -731,6 +759,7 @@ class GltfMeshBuilder {
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                       const std::filesystem::path& base_dir) {
   const tinygltf::Model model = read_model(bytes, display_name, base_dir);
+  check_required_extensions(model, display_name);
   const std::vector<int> roots = root_nodes(model, display_name);
   GltfMeshBuilder builder(model, display_name);
   builder.add_node_trees(roots);
