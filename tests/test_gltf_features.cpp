@@ -1,5 +1,6 @@
 // Tests of the glTF features beyond plain triangle lists (src/scene/mesh_gltf.cpp): strips and
-// fans, points and lines counted in a warning, extensionsRequired. Every file is written here
+// fans, points and lines counted in a warning, extensionsRequired, KHR_draco_mesh_compression
+// (streams encoded here with libdraco). Every file is written here
 // by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
@@ -8,10 +9,18 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <draco/compression/decode.h>
+#include <draco/compression/encode.h>
+#include <draco/mesh/triangle_soup_mesh_builder.h>
+
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "test_cli_run.hpp"
@@ -199,4 +208,108 @@ TEST_CASE("KHR_mesh_quantization: normalized short positions load as v / 32767",
   b.gltf["bufferViews"][0]["byteStride"] = 8;
   const auto mesh = covrast::load_mesh(dir.write("quantized.glb", b.glb()));
   REQUIRE(mesh->positions == std::vector<glm::vec3>{{0, 0, 0}, {1, 0, 0}, {0, -1, 0}});
+}
+
+namespace {
+
+/// Two counter-clockwise triangles of the square [0, 1]^2 at z = 0.5 with normals +z,
+/// compressed by libdraco (sequential, lossless), POSITION as unique id 0 and NORMAL as 1.
+std::string draco_square() {
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(2);
+  const int position =
+      builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  const int normal = builder.AddAttribute(draco::GeometryAttribute::NORMAL, 3, draco::DT_FLOAT32);
+  const draco::Vector3f p[4] = {{0, 0, 0.5f}, {1, 0, 0.5f}, {1, 1, 0.5f}, {0, 1, 0.5f}};
+  const draco::Vector3f n(0, 0, 1);
+  builder.SetAttributeValuesForFace(position, draco::FaceIndex(0), p[0].data(), p[1].data(),
+                                    p[2].data());
+  builder.SetAttributeValuesForFace(position, draco::FaceIndex(1), p[0].data(), p[2].data(),
+                                    p[3].data());
+  for (const int face : {0, 1}) {
+    builder.SetAttributeValuesForFace(normal, draco::FaceIndex(face), n.data(), n.data(), n.data());
+  }
+  const std::unique_ptr<draco::Mesh> mesh = builder.Finalize();
+  REQUIRE(mesh != nullptr);
+  draco::Encoder encoder;
+  encoder.SetSpeedOptions(10, 10);  // sequential coding, no quantization set: lossless
+  draco::EncoderBuffer out;
+  REQUIRE(encoder.EncodeMeshToBuffer(*mesh, &out).ok());
+  return std::string(out.data(), out.size());
+}
+
+/// A glTF document whose one primitive is `stream` (draco_square's layout), with accessors
+/// that have no bufferView, as the extension prescribes.
+GltfBuilder draco_document(const std::string& stream, int points) {
+  GltfBuilder b;
+  const int view = b.add_view(stream);
+  b.gltf["accessors"] = {{{"componentType", 5126}, {"count", points}, {"type", "VEC3"}},
+                         {{"componentType", 5126}, {"count", points}, {"type", "VEC3"}},
+                         {{"componentType", 5123}, {"count", 6}, {"type", "SCALAR"}}};
+  b.single_mesh({{{"attributes", {{"POSITION", 0}, {"NORMAL", 1}}},
+                  {"indices", 2},
+                  {"extensions",
+                   {{"KHR_draco_mesh_compression",
+                     {{"bufferView", view}, {"attributes", {{"POSITION", 0}, {"NORMAL", 1}}}}}}}}});
+  b.gltf["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+  b.gltf["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+  return b;
+}
+
+/// The mesh's triangles as corner positions, each rotated to start at its smallest corner
+/// and sorted, so that two meshes compare whatever order the encoder chose.
+std::vector<std::array<glm::vec3, 3>> canonical_triangles(const covrast::MeshData& mesh) {
+  const auto less = [](const glm::vec3& a, const glm::vec3& b) {
+    return std::tie(a.x, a.y, a.z) < std::tie(b.x, b.y, b.z);
+  };
+  std::vector<std::array<glm::vec3, 3>> triangles;
+  for (std::size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+    std::array<glm::vec3, 3> corners = {mesh.positions[mesh.indices[t]],
+                                        mesh.positions[mesh.indices[t + 1]],
+                                        mesh.positions[mesh.indices[t + 2]]};
+    while (less(corners[1], corners[0]) || less(corners[2], corners[0])) {
+      std::rotate(corners.begin(), corners.begin() + 1, corners.end());
+    }
+    triangles.push_back(corners);
+  }
+  std::sort(triangles.begin(), triangles.end(), [&](const auto& a, const auto& b) {
+    return std::lexicographical_compare(a.begin(), a.end(), b.begin(), b.end(), less);
+  });
+  return triangles;
+}
+
+}  // namespace
+
+TEST_CASE("KHR_draco_mesh_compression primitives decode with libdraco (.glb and .gltf)", "[gltf]") {
+  TempDir dir;
+  const std::string stream = draco_square();
+  draco::DecoderBuffer probe;
+  probe.Init(stream.data(), stream.size());
+  const auto decoded = draco::Decoder().DecodeMeshFromBuffer(&probe);
+  REQUIRE(decoded.ok());
+  const int points = static_cast<int>(decoded.value()->num_points());
+  GltfBuilder b = draco_document(stream, points);
+
+  const std::vector<std::array<glm::vec3, 3>> expected = {
+      {glm::vec3(0, 0, 0.5f), glm::vec3(1, 0, 0.5f), glm::vec3(1, 1, 0.5f)},
+      {glm::vec3(0, 0, 0.5f), glm::vec3(1, 1, 0.5f), glm::vec3(0, 1, 0.5f)}};
+  const auto glb_mesh = covrast::load_mesh(dir.write("square.glb", b.glb()));
+  REQUIRE(canonical_triangles(*glb_mesh) == expected);
+  REQUIRE(glb_mesh->corner_normals == std::vector<glm::vec3>(6, glm::vec3(0, 0, 1)));
+
+  // The same document as .gltf text with the buffer as a data: URI.
+  const auto text_mesh = covrast::load_mesh(dir.write("square.gltf", b.gltf_text()));
+  REQUIRE(canonical_triangles(*text_mesh) == expected);
+
+  // A stream that does not decode, and an attribute id the stream lacks: InputErrors.
+  GltfBuilder broken = draco_document(stream.substr(0, stream.size() / 2), points);
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("broken.glb", broken.glb())),
+                      Contains("broken.glb: mesh 0 primitive 0: KHR_draco_mesh_compression: "
+                               "cannot decode"));
+  GltfBuilder missing = draco_document(stream, points);
+  missing.gltf["meshes"][0]["primitives"][0]["extensions"]["KHR_draco_mesh_compression"]
+              ["attributes"]["NORMAL"] = 7;
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("missing.glb", missing.glb())),
+                      Contains("missing.glb: mesh 0 primitive 0: KHR_draco_mesh_compression: "
+                               "NORMAL names Draco attribute 7, which the stream does not hold"));
 }

@@ -73,7 +73,7 @@ inline std::string make_glb(std::string json_text, std::string bin) {
 
 /// A glTF document with one binary buffer: each add_* call appends a 4-byte aligned buffer
 /// view and an accessor over it and returns the accessor's index. `gltf` is filled in by the
-/// test (nodes, meshes, ...); glb() writes the whole file.
+/// test (nodes, meshes, ...); glb() and gltf_text() write the whole file.
 class GltfBuilder {
  public:
   nlohmann::json gltf = {{"asset", {{"version", "2.0"}}}};
@@ -111,7 +111,14 @@ class GltfBuilder {
     gltf["nodes"] = {{{"mesh", 0}}};
     gltf["meshes"] = {{{"primitives", primitives}}};
   }
-  std::string glb() {
+  /// The document as .gltf text, its buffer inlined as a base64 data: URI.
+  std::string gltf_text() const {
+    nlohmann::json document = gltf;
+    document["buffers"] = {{{"byteLength", bin_.size()},
+                            {"uri", "data:application/octet-stream;base64," + base64(bin_)}}};
+    return document.dump();
+  }
+  std::string glb() const {
     nlohmann::json document = gltf;
     document["buffers"] = {{{"byteLength", bin_.size()}}};
     return make_glb(document.dump(), bin_);

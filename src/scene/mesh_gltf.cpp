@@ -5,6 +5,7 @@
 // COLOR_0 x baseColorFactor into colors_linear; points and lines are counted in a warning.
 // glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
 // bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
+#include "scene/gltf_draco.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <tiny_gltf.h>
@@ -16,6 +17,8 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <map>
+#include <optional>
 #include <string_view>
 #include <vector>
 
@@ -142,11 +145,9 @@ struct Reader {
   const tinygltf::Model& model;
   const std::string& name;
 
-  /// Reads `count` elements of `components` components from a buffer view into `out`.
-  /// `strided`: honour the view's byteStride (vertex attributes), else tightly packed.
-  void read_view(const std::string& what, int view_index, std::size_t byte_offset,
-                 std::size_t count, int component_type, int components, bool normalized,
-                 bool strided, double* out) const {
+  /// The first byte of buffer view `view_index`, checked to lie with its byteLength bytes
+  /// inside its buffer.
+  const unsigned char* view_bytes(const std::string& what, int view_index) const {
     if (view_index < 0 || static_cast<std::size_t>(view_index) >= model.bufferViews.size()) {
       fail(name, what + ": bufferView " + std::to_string(view_index) + " does not exist");
     }
@@ -159,6 +160,16 @@ struct Reader {
     if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
       fail(name, what + ": bufferView " + std::to_string(view_index) + " exceeds its buffer");
     }
+    return data.data() + view.byteOffset;
+  }
+
+  /// Reads `count` elements of `components` components from a buffer view into `out`.
+  /// `strided`: honour the view's byteStride (vertex attributes), else tightly packed.
+  void read_view(const std::string& what, int view_index, std::size_t byte_offset,
+                 std::size_t count, int component_type, int components, bool normalized,
+                 bool strided, double* out) const {
+    const unsigned char* view_begin = view_bytes(what, view_index);
+    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(view_index)];
     if (count == 0) return;
     const std::size_t element_bytes =
         static_cast<std::size_t>(component_size_bytes(component_type)) *
@@ -171,7 +182,7 @@ struct Reader {
       fail(name,
            what + ": accessor reads past the end of bufferView " + std::to_string(view_index));
     }
-    const unsigned char* base = data.data() + view.byteOffset + byte_offset;
+    const unsigned char* base = view_begin + byte_offset;
     const std::size_t size = static_cast<std::size_t>(component_size_bytes(component_type));
     for (std::size_t i = 0; i < count; ++i) {
       for (int c = 0; c < components; ++c) {
@@ -358,23 +369,11 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
   return normals;
 }
 
-/// The primitive's NORMAL attribute in world space, or empty when it has none.
-std::vector<glm::vec3> primitive_normals(const Reader& reader, const tinygltf::Primitive& primitive,
-                                         const std::string& what, const glm::dmat4& world,
-                                         std::size_t vertex_count) {
-  const auto it = primitive.attributes.find("NORMAL");
-  if (it == primitive.attributes.end()) return {};
-  int components = 0;
-  const std::vector<double> values = reader.read_accessor(what + " NORMAL", it->second, components);
-  if (components != 3) fail(reader.name, what + ": NORMAL must be VEC3");
-  if (values.size() / 3 != vertex_count)
-    fail(reader.name, what + ": NORMAL and POSITION counts differ");
-  return world_normals(values, world);
-}
-
 /// The file as tinygltf reads it (images accepted without decoding); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                            const std::filesystem::path& base_dir) {
+  const std::optional<std::string> rewritten = without_draco_indices(bytes);
+  if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&skip_image, nullptr);
@@ -395,8 +394,9 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 3> kImplementedExtensions = {
-    "KHR_materials_emissive_strength", "KHR_materials_unlit", "KHR_mesh_quantization"};
+constexpr std::array<std::string_view, 4> kImplementedExtensions = {
+    kDracoExtension, "KHR_materials_emissive_strength", "KHR_materials_unlit",
+    "KHR_mesh_quantization"};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -435,6 +435,19 @@ std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& nam
   }
   return roots;
 }
+
+/// A primitive's vertex data as the file gives it, before placement.
+struct PrimitiveVertices {
+  std::vector<double> positions;  ///< object space, 3 per vertex
+  std::vector<double> normals;    ///< object space, 3 per vertex; empty without NORMAL
+  std::size_t count() const { return positions.size() / 3; }
+};
+
+/// Where a primitive's attributes come from: its accessors, or its decoded Draco stream.
+struct PrimitiveSource {
+  const tinygltf::Primitive& primitive;
+  std::optional<DracoPrimitive> draco;
+};
 
 /// Collects the triangle primitives of the node tree into one MeshData: positions, indices,
 /// materials and normals as it goes, and the colours with what decides between vertex
@@ -539,38 +552,36 @@ class GltfMeshBuilder {
   /// names it in messages.
   void add_primitive(const tinygltf::Primitive& primitive, int mode, const std::string& what,
                      const glm::dmat4& world) {
-    const auto position_it = primitive.attributes.find("POSITION");
-    if (position_it == primitive.attributes.end()) fail(name_, what + ": no POSITION attribute");
-    int components = 0;
-    const std::vector<double> positions =
-        reader_.read_accessor(what + " POSITION", position_it->second, components);
-    if (components != 3) fail(name_, what + ": POSITION must be VEC3");
-    const std::size_t vertex_count = positions.size() / 3;
+    const PrimitiveSource source{primitive, decode_draco_primitive(primitive, what)};
+    if (source.draco) mode = TINYGLTF_MODE_TRIANGLES;  // the decoded faces are a triangle list
+    const PrimitiveVertices vertices = read_vertices(source, what);
+    const std::size_t vertex_count = vertices.count();
+    if (vertex_count > kMaxVertices - mesh_->positions.size()) fail(name_, "too many vertices");
+    const std::vector<std::uint32_t> corners = triangle_corners(
+        mode, vertex_sequence(source, what, vertex_count), primitive.indices >= 0, what);
+    const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count);
+    const std::uint32_t material = primitive.material >= 0
+                                       ? static_cast<std::uint32_t>(primitive.material)
+                                       : default_material_;
+    place(vertices, corners, colors, material, world);
+  }
+
+  /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
+  /// triangles (turned when `world` mirrors), their material and their normals.
+  void place(const PrimitiveVertices& vertices, const std::vector<std::uint32_t>& corners,
+             const std::vector<glm::vec3>& colors, std::uint32_t material,
+             const glm::dmat4& world) {
     const std::size_t base = mesh_->positions.size();
-    if (vertex_count > kMaxVertices - base) fail(name_, "too many vertices");
-
-    const glm::dvec3 factor = base_color_factor(primitive, what);
-    const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
-                                   clamp_unit(factor.b));
-    if (!any_primitive_) {
-      first_factor_ = factor_clamped;
-    } else if (factor_clamped != first_factor_) {
-      factors_differ_ = true;
-    }
-    any_primitive_ = true;
-
-    for (std::size_t v = 0; v < vertex_count; ++v) {
+    const std::vector<double>& positions = vertices.positions;
+    for (std::size_t v = 0; v < vertices.count(); ++v) {
       const glm::dvec4 p_world =
           world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0);
       mesh_->positions.emplace_back(static_cast<float>(p_world.x), static_cast<float>(p_world.y),
                                     static_cast<float>(p_world.z));
     }
-    add_colors(primitive, what, vertex_count, factor, factor_clamped);
-
+    colors_.insert(colors_.end(), colors.begin(), colors.end());
     const std::size_t first_index = mesh_->indices.size();
-    add_triangles(triangle_corners(mode, vertex_sequence(primitive, what, vertex_count),
-                                   primitive.indices >= 0, what),
-                  base);
+    add_triangles(corners, base);
     // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
     // clockwise; swapping two corners keeps counter-clockwise = front after baking.
     if (glm::determinant(glm::dmat3(world)) < 0.0) {
@@ -578,12 +589,80 @@ class GltfMeshBuilder {
         std::swap(mesh_->indices[i + 1], mesh_->indices[i + 2]);
       }
     }
-    const std::uint32_t material = primitive.material >= 0
-                                       ? static_cast<std::uint32_t>(primitive.material)
-                                       : default_material_;
     mesh_->triangle_materials.resize(mesh_->indices.size() / 3, material);
-    add_corner_normals(primitive_normals(reader_, primitive, what, world, vertex_count), base,
-                       first_index);
+    add_corner_normals(vertices.normals.empty() ? std::vector<glm::vec3>{}
+                                                : world_normals(vertices.normals, world),
+                       base, first_index);
+  }
+
+  /// The primitive's Draco stream decoded, when it has the extension (gltf_draco.hpp).
+  std::optional<DracoPrimitive> decode_draco_primitive(const tinygltf::Primitive& primitive,
+                                                       const std::string& what) const {
+    const auto it = primitive.extensions.find(std::string(kDracoExtension));
+    if (it == primitive.extensions.end()) return std::nullopt;
+    const tinygltf::Value& extension = it->second;
+    const std::string where = what + ": " + std::string(kDracoExtension);
+    if (!extension.IsObject() || !extension.Has("bufferView") ||
+        !extension.Get("bufferView").IsInt() || !extension.Get("attributes").IsObject()) {
+      fail(name_, where + ": needs a bufferView and an attributes object");
+    }
+    const int view_index = extension.Get("bufferView").GetNumberAsInt();
+    const unsigned char* bytes = reader_.view_bytes(where, view_index);
+    const std::size_t size = model_.bufferViews[static_cast<std::size_t>(view_index)].byteLength;
+    std::map<std::string, DracoAttributeRef> refs;
+    const tinygltf::Value& attributes = extension.Get("attributes");
+    for (const std::string& key : attributes.Keys()) {
+      const tinygltf::Value& id = attributes.Get(key);
+      if (!id.IsInt() || id.GetNumberAsInt() < 0) {
+        fail(name_, where + ": attribute " + printable(key) + " needs a Draco id");
+      }
+      const auto accessor = primitive.attributes.find(key);
+      const bool normalized =
+          accessor != primitive.attributes.end() && accessor->second >= 0 &&
+          static_cast<std::size_t>(accessor->second) < model_.accessors.size() &&
+          model_.accessors[static_cast<std::size_t>(accessor->second)].normalized;
+      refs[key] = {static_cast<std::uint32_t>(id.GetNumberAsInt()), normalized};
+    }
+    return decode_draco(bytes, size, refs, name_, what);
+  }
+
+  /// Attribute `attribute` of the primitive (its Draco values first, else its accessor), or
+  /// nullopt when it has none; `components` receives the element width.
+  std::optional<std::vector<double>> attribute_values(const PrimitiveSource& source,
+                                                      const std::string& attribute,
+                                                      const std::string& what,
+                                                      int& components) const {
+    if (source.draco) {
+      const auto it = source.draco->attributes.find(attribute);
+      if (it != source.draco->attributes.end()) {
+        components = it->second.components;
+        return it->second.values;
+      }
+    }
+    const auto it = source.primitive.attributes.find(attribute);
+    if (it == source.primitive.attributes.end()) return std::nullopt;
+    return reader_.read_accessor(what + " " + attribute, it->second, components);
+  }
+
+  /// POSITION and NORMAL (when present) as the file gives them.
+  PrimitiveVertices read_vertices(const PrimitiveSource& source, const std::string& what) const {
+    PrimitiveVertices vertices;
+    int components = 0;
+    std::optional<std::vector<double>> positions =
+        attribute_values(source, "POSITION", what, components);
+    if (!positions) fail(name_, what + ": no POSITION attribute");
+    if (components != 3) fail(name_, what + ": POSITION must be VEC3");
+    vertices.positions = std::move(*positions);
+    std::optional<std::vector<double>> normals =
+        attribute_values(source, "NORMAL", what, components);
+    if (normals) {
+      if (components != 3) fail(name_, what + ": NORMAL must be VEC3");
+      if (normals->size() != vertices.positions.size()) {
+        fail(name_, what + ": NORMAL and POSITION counts differ");
+      }
+      vertices.normals = std::move(*normals);
+    }
+    return vertices;
   }
 
   /// The primitive's material's baseColorFactor (RGB), or 1 without a material.
@@ -601,36 +680,53 @@ class GltfMeshBuilder {
     return factor;
   }
 
-  /// The primitive's vertex colours: COLOR_0 x factor, or the (clamped) factor alone.
-  void add_colors(const tinygltf::Primitive& primitive, const std::string& what,
-                  std::size_t vertex_count, glm::dvec3 factor, glm::vec3 factor_clamped) {
-    const auto color_it = primitive.attributes.find("COLOR_0");
-    if (color_it == primitive.attributes.end()) {
-      colors_.insert(colors_.end(), vertex_count, factor_clamped);
-      return;
+  /// The primitive's vertex colours: COLOR_0 x baseColorFactor, or the (clamped) factor
+  /// alone. Notes what decides the mesh's colour selection (finish()).
+  std::vector<glm::vec3> vertex_colors(const PrimitiveSource& source, const std::string& what,
+                                       std::size_t vertex_count) {
+    const glm::dvec3 factor = base_color_factor(source.primitive, what);
+    const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
+                                   clamp_unit(factor.b));
+    if (!any_primitive_) {
+      first_factor_ = factor_clamped;
+    } else if (factor_clamped != first_factor_) {
+      factors_differ_ = true;
     }
+    any_primitive_ = true;
+    int components = 0;
+    const std::optional<std::vector<double>> values =
+        attribute_values(source, "COLOR_0", what, components);
+    if (!values) return std::vector<glm::vec3>(vertex_count, factor_clamped);
     any_color_attribute_ = true;
-    int color_components = 0;
-    const std::vector<double> color_values =
-        reader_.read_accessor(what + " COLOR_0", color_it->second, color_components);
-    if (color_components != 3 && color_components != 4) {
-      fail(name_, what + ": COLOR_0 must be VEC3 or VEC4");
-    }
-    const auto width = static_cast<std::size_t>(color_components);
-    if (color_values.size() / width != vertex_count) {
+    if (components != 3 && components != 4) fail(name_, what + ": COLOR_0 must be VEC3 or VEC4");
+    const auto width = static_cast<std::size_t>(components);
+    if (values->size() / width != vertex_count) {
       fail(name_, what + ": COLOR_0 and POSITION counts differ");
     }
+    std::vector<glm::vec3> colors;
+    colors.reserve(vertex_count);
     for (std::size_t v = 0; v < vertex_count; ++v) {
-      colors_.emplace_back(clamp_unit(color_values[width * v] * factor.r),
-                           clamp_unit(color_values[width * v + 1] * factor.g),
-                           clamp_unit(color_values[width * v + 2] * factor.b));
+      colors.emplace_back(clamp_unit((*values)[width * v] * factor.r),
+                          clamp_unit((*values)[width * v + 1] * factor.g),
+                          clamp_unit((*values)[width * v + 2] * factor.b));
     }
+    return colors;
   }
 
-  /// The primitive's vertex sequence: its index accessor, or 0, 1, ... when it has none.
-  std::vector<std::uint32_t> vertex_sequence(const tinygltf::Primitive& primitive,
-                                             const std::string& what,
+  /// The primitive's vertex sequence: its index accessor, its Draco faces, or 0, 1, ... when
+  /// it has neither.
+  std::vector<std::uint32_t> vertex_sequence(const PrimitiveSource& source, const std::string& what,
                                              std::size_t vertex_count) const {
+    const tinygltf::Primitive& primitive = source.primitive;
+    if (source.draco) {
+      for (const std::uint32_t corner : source.draco->corners) {
+        if (corner >= vertex_count) {
+          fail(name_, what + ": Draco corner " + std::to_string(corner) + " out of range (" +
+                          std::to_string(vertex_count) + " vertices)");
+        }
+      }
+      return source.draco->corners;
+    }
     std::vector<std::uint32_t> sequence;
     if (primitive.indices < 0) {
       sequence.resize(vertex_count);
