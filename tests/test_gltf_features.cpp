@@ -1,7 +1,7 @@
 // Tests of the glTF features beyond plain triangle lists (src/scene/mesh_gltf.cpp): strips and
 // fans, points and lines counted in a warning, extensionsRequired, KHR_draco_mesh_compression
-// (streams encoded here with libdraco). Every file is written here
-// by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
+// (streams encoded here with libdraco), morph targets, skins and EXT_mesh_gpu_instancing. Every
+// file is written here by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -312,4 +313,153 @@ TEST_CASE("KHR_draco_mesh_compression primitives decode with libdraco (.glb and 
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("missing.glb", missing.glb())),
                       Contains("missing.glb: mesh 0 primitive 0: KHR_draco_mesh_compression: "
                                "NORMAL names Draco attribute 7, which the stream does not hold"));
+}
+
+namespace {
+
+/// The triangle (0,0,0), (1,0,0), (0,1,0) with NORMAL +z, as POSITION and NORMAL accessors.
+json unit_triangle(GltfBuilder& b) {
+  const int positions = b.add_floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+  const int normals = b.add_floats({0, 0, 1, 0, 0, 1, 0, 0, 1}, "VEC3");
+  return {{"POSITION", positions}, {"NORMAL", normals}};
+}
+
+void require_positions(const covrast::MeshData& mesh, const std::vector<glm::vec3>& expected) {
+  REQUIRE(mesh.positions.size() == expected.size());
+  for (std::size_t v = 0; v < expected.size(); ++v) {
+    for (int c = 0; c < 3; ++c) {
+      INFO("vertex " << v << " component " << c);
+      REQUIRE(mesh.positions[v][c] == Approx(expected[v][c]).margin(1e-6));
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("glTF morph targets apply the mesh's default weights, or the node's", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const json attributes = unit_triangle(b);
+  // Target 0 lifts vertex 2 by (0, 1, 0) and tilts its normal by (1, 0, 0); target 1 moves
+  // vertex 1 by (1, 0, 0).
+  const int lift = b.add_floats({0, 0, 0, 0, 0, 0, 0, 1, 0}, "VEC3");
+  const int tilt = b.add_floats({0, 0, 0, 0, 0, 0, 1, 0, 0}, "VEC3");
+  const int stretch = b.add_floats({0, 0, 0, 1, 0, 0, 0, 0, 0}, "VEC3");
+  b.gltf["scenes"] = {{{"nodes", {0, 1}}}};
+  // Node 0 uses the mesh's weights (0.5, 0.25); node 1, moved by z = 1, its own (1, 0).
+  b.gltf["nodes"] = {{{"mesh", 0}},
+                     {{"mesh", 0}, {"weights", {1.0, 0.0}}, {"translation", {0, 0, 1}}}};
+  const json targets = {{{"POSITION", lift}, {"NORMAL", tilt}}, {{"POSITION", stretch}}};
+  const json primitive = {{"attributes", attributes}, {"targets", targets}};
+  b.gltf["meshes"] = {{{"weights", {0.5, 0.25}}, {"primitives", {primitive}}}};
+  const auto mesh = covrast::load_mesh(dir.write("morph.glb", b.glb()));
+  // p = p_0 + sum_i w_i d_i.
+  require_positions(*mesh, {{0, 0, 0},
+                            {1.25f, 0, 0},
+                            {0, 1.5f, 0},  //
+                            {0, 0, 1},
+                            {1, 0, 1},
+                            {0, 2, 1}});
+  // Vertex 2's normal: normalize((0, 0, 1) + w (1, 0, 0)), w = 0.5, then 1.
+  REQUIRE(mesh->corner_normals.size() == 6);
+  const float a = static_cast<float>(1 / std::sqrt(1.25)), s = static_cast<float>(std::sqrt(0.5));
+  REQUIRE(mesh->corner_normals[2].x == Approx(0.5f * a));
+  REQUIRE(mesh->corner_normals[2].z == Approx(a));
+  REQUIRE(mesh->corner_normals[5].x == Approx(s));
+  REQUIRE(mesh->corner_normals[5].z == Approx(s));
+  REQUIRE(mesh->corner_normals[0] == glm::vec3(0, 0, 1));
+
+  b.gltf["meshes"][0]["weights"] = {0.5};
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("weights.glb", b.glb())),
+                      Contains("weights.glb: mesh 0 primitive 0: 2 morph targets but 1 weights"));
+}
+
+namespace {
+
+/// A skinned triangle: joint 0 is node 1 (the origin), joint 1 is node 2 at (0, 1, 0) turned
+/// by 90 degrees about +z, bound at (0, 1, 0) (inverse bind matrix: translate by (0, -1, 0)).
+/// The mesh node 0 is moved by (100, 0, 0), which skinning must ignore. Vertices: (1, 0, 0)
+/// on joint 0, (0, 2, 0) on joint 1, (0, 1, 0) half on each.
+GltfBuilder skinned_triangle() {
+  GltfBuilder b;
+  const int positions = b.add_floats({1, 0, 0, 0, 2, 0, 0, 1, 0}, "VEC3");
+  const int normals = b.add_floats({0, 0, 1, 1, 0, 0, 0, 0, 1}, "VEC3");
+  const int joints = b.add_u16({0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0}, "VEC4");
+  const int weights = b.add_floats({1, 0, 0, 0, 1, 0, 0, 0, 0.5f, 0.5f, 0, 0}, "VEC4");
+  const int inverse_binds = b.add_floats({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0,  0, 1,  //
+                                          1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, -1, 0, 1},
+                                         "MAT4");
+  const double h = std::sqrt(0.5);
+  b.gltf["scenes"] = {{{"nodes", {0, 1}}}};
+  b.gltf["nodes"] = {{{"mesh", 0}, {"skin", 0}, {"translation", {100, 0, 0}}},
+                     {{"children", {2}}},
+                     {{"translation", {0, 1, 0}}, {"rotation", {0, 0, h, h}}}};
+  b.gltf["skins"] = {{{"joints", {1, 2}}, {"inverseBindMatrices", inverse_binds}}};
+  b.gltf["meshes"] = {{{"primitives",
+                        {{{"attributes",
+                           {{"POSITION", positions},
+                            {"NORMAL", normals},
+                            {"JOINTS_0", joints},
+                            {"WEIGHTS_0", weights}}}}}}}};
+  return b;
+}
+
+}  // namespace
+
+TEST_CASE("glTF skins pose the vertices by the joints' static transforms", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b = skinned_triangle();
+  const auto mesh = covrast::load_mesh(dir.write("skin.glb", b.glb()));
+  // v' = sum_i w_i G(joint_i) IBM_i v; joint 1: T(0,1,0) Rz(90) T(0,-1,0) (0,2,0) = (-1,1,0);
+  // (0,1,0) is a fixed point of both joints.
+  require_positions(*mesh, {{1, 0, 0}, {-1, 1, 0}, {0, 1, 0}});
+  // Vertex 1's normal (1, 0, 0) turns with joint 1 to (0, 1, 0).
+  REQUIRE(mesh->corner_normals[1].x == Approx(0.0f).margin(1e-6));
+  REQUIRE(mesh->corner_normals[1].y == Approx(1.0f));
+
+  b.gltf["skins"][0]["joints"] = {1};
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("joints.glb", b.glb())),
+                      Contains("joints.glb: mesh 0 primitive 0: joint 1 out of range (1 joints)"));
+  b = skinned_triangle();
+  b.gltf["scenes"][0]["nodes"] = {0};
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("scene.glb", b.glb())),
+                      Contains("scene.glb: node 0: skin 0: joint node 1 is not in the scene"));
+}
+
+TEST_CASE("EXT_mesh_gpu_instancing draws the mesh once per instance", "[gltf]") {
+  TempDir dir;
+  GltfBuilder b;
+  const json attributes = unit_triangle(b);
+  const double h = std::sqrt(0.5);
+  // Instance 0: at (0, 5, 0); instance 1: turned by 90 degrees about +z; instance 2: mirrored
+  // in x (its winding must be turned back). All under a node moved by (10, 0, 0).
+  const int translation = b.add_floats({0, 5, 0, 0, 0, 0, 0, 0, 0}, "VEC3");
+  const int rotation = b.add_floats(
+      {0, 0, 0, 1, 0, 0, static_cast<float>(h), static_cast<float>(h), 0, 0, 0, 1}, "VEC4");
+  const int scale = b.add_floats({1, 1, 1, 1, 1, 1, -1, 1, 1}, "VEC3");
+  b.single_mesh({{{"attributes", attributes}}});
+  b.gltf["nodes"][0]["translation"] = {10, 0, 0};
+  b.gltf["nodes"][0]["extensions"] = {
+      {"EXT_mesh_gpu_instancing",
+       {{"attributes", {{"TRANSLATION", translation}, {"ROTATION", rotation}, {"SCALE", scale}}}}}};
+  b.gltf["extensionsUsed"] = {"EXT_mesh_gpu_instancing"};
+  b.gltf["extensionsRequired"] = {"EXT_mesh_gpu_instancing"};
+  const auto mesh = covrast::load_mesh(dir.write("instances.glb", b.glb()));
+  require_positions(*mesh, {{10, 5, 0},
+                            {11, 5, 0},
+                            {10, 6, 0},  //
+                            {10, 0, 0},
+                            {10, 1, 0},
+                            {9, 0, 0},  //
+                            {10, 0, 0},
+                            {9, 0, 0},
+                            {10, 1, 0}});
+  REQUIRE(mesh->indices == std::vector<std::uint32_t>{0, 1, 2, 3, 4, 5, 6, 8, 7});
+  for (const float z : winding_z(*mesh)) REQUIRE(z > 0.0f);
+
+  b.gltf["nodes"][0]["extensions"]["EXT_mesh_gpu_instancing"]["attributes"]["SCALE"] =
+      b.add_floats({1, 1, 1}, "VEC3");
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("counts.glb", b.glb())),
+                      Contains("counts.glb: node 0: EXT_mesh_gpu_instancing: TRANSLATION, "
+                               "ROTATION and SCALE counts differ"));
 }

@@ -103,6 +103,8 @@ int component_count(int type) {
       return 3;
     case TINYGLTF_TYPE_VEC4:
       return 4;
+    case TINYGLTF_TYPE_MAT4:
+      return 16;
     default:
       return 0;
   }
@@ -262,6 +264,22 @@ struct Reader {
   }
 };
 
+/// Unit quaternion (x, y, z, w) -> rotation matrix; normalised first for robustness.
+glm::dmat4 rotation_matrix(double x, double y, double z, double w) {
+  const double length = std::sqrt(x * x + y * y + z * z + w * w);
+  if (length > 0.0) {
+    x /= length;
+    y /= length;
+    z /= length;
+    w /= length;
+  }
+  glm::dmat4 r(1.0);
+  r[0] = glm::dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0);
+  r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0);
+  r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0);
+  return r;
+}
+
 /// Node-local transform: the matrix when given (column-major, like GLM), else T * R * S.
 glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, int node_index) {
   const std::string what = "node " + std::to_string(node_index);
@@ -285,18 +303,7 @@ glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, 
   }
   glm::dmat4 r(1.0);
   if (!node.rotation.empty()) {
-    // Unit quaternion (x, y, z, w) -> rotation matrix; normalised first for robustness.
-    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
-    const double length = std::sqrt(x * x + y * y + z * z + w * w);
-    if (length > 0.0) {
-      x /= length;
-      y /= length;
-      z /= length;
-      w /= length;
-    }
-    r[0] = glm::dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0);
-    r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0);
-    r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0);
+    r = rotation_matrix(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
   }
   glm::dmat4 s(1.0);
   if (!node.scale.empty()) {
@@ -394,9 +401,9 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 4> kImplementedExtensions = {
-    kDracoExtension, "KHR_materials_emissive_strength", "KHR_materials_unlit",
-    "KHR_mesh_quantization"};
+constexpr std::array<std::string_view, 5> kImplementedExtensions = {
+    kDracoExtension, "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
+    "KHR_materials_unlit", "KHR_mesh_quantization"};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -449,6 +456,15 @@ struct PrimitiveSource {
   std::optional<DracoPrimitive> draco;
 };
 
+/// How one node's mesh reaches the file's world space, and its morph weights.
+struct Placement {
+  std::vector<glm::dmat4> worlds;       ///< one copy per matrix (instances); unskinned only
+  std::vector<glm::dmat4> skin_joints;  ///< skinned: the joint matrices, `worlds` unused
+  std::vector<double> morph_weights;    ///< the node's weights, else the mesh's
+};
+
+inline constexpr std::string_view kInstancingExtension = "EXT_mesh_gpu_instancing";
+
 /// Collects the triangle primitives of the node tree into one MeshData: positions, indices,
 /// materials and normals as it goes, and the colours with what decides between vertex
 /// colours and one uniform colour (LoadedMesh::has_uniform_color) at the end.
@@ -469,34 +485,9 @@ class GltfMeshBuilder {
   /// Walks the node trees under `roots` depth first, in file order, composing the node
   /// transforms, and adds every mesh it meets once per node that uses it.
   void add_node_trees(const std::vector<int>& roots) {
-    struct Pending {
-      int node;
-      glm::dmat4 parent;
-    };
-    const std::size_t node_count = model_.nodes.size();
-    std::vector<Pending> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
-      stack.push_back({*it, glm::dmat4(1.0)});
-    }
-    std::vector<bool> visited(node_count, false);
-    while (!stack.empty()) {
-      const Pending current = stack.back();
-      stack.pop_back();
-      if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
-        fail(name_, "node " + std::to_string(current.node) + " does not exist");
-      }
-      const auto node_index = static_cast<std::size_t>(current.node);
-      if (visited[node_index]) {
-        fail(name_, "node " + std::to_string(current.node) +
-                        " is reached twice (the node hierarchy must be a tree)");
-      }
-      visited[node_index] = true;
-      const tinygltf::Node& node = model_.nodes[node_index];
-      const glm::dmat4 world = current.parent * local_transform(node, name_, current.node);
-      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
-        stack.push_back({*it, world});
-      }
-      if (node.mesh >= 0) add_mesh(current.node, node.mesh, world);
+    for (const int node_index : walk_nodes(roots)) {
+      const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
+      if (node.mesh >= 0) add_mesh(node_index, node.mesh, node_placement(node_index));
     }
   }
 
@@ -526,12 +517,16 @@ class GltfMeshBuilder {
  private:
   /// Mesh `mesh_index` of node `node_index`, with the node's world transform. Primitives of
   /// the point and line modes are counted (LoadedMesh::warnings), not drawn.
-  void add_mesh(int node_index, int mesh_index, const glm::dmat4& world) {
+  void add_mesh(int node_index, int mesh_index, Placement placement) {
     if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size()) {
       fail(name_, "node " + std::to_string(node_index) + ": mesh " + std::to_string(mesh_index) +
                       " does not exist");
     }
     const tinygltf::Mesh& gltf_mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
+    // glTF 2.0, 3.7.2.2: the node's weights override the mesh's default weights.
+    const std::vector<double>& node_weights =
+        model_.nodes[static_cast<std::size_t>(node_index)].weights;
+    placement.morph_weights = node_weights.empty() ? gltf_mesh.weights : node_weights;
     for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = gltf_mesh.primitives[p];
       const std::string what =
@@ -544,17 +539,18 @@ class GltfMeshBuilder {
         ++undrawn_primitives_[static_cast<std::size_t>(mode)];
         continue;
       }
-      add_primitive(primitive, mode, what, world);
+      add_primitive(primitive, mode, what, placement);
     }
   }
 
   /// One primitive of a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN); `what`
   /// names it in messages.
   void add_primitive(const tinygltf::Primitive& primitive, int mode, const std::string& what,
-                     const glm::dmat4& world) {
+                     const Placement& placement) {
     const PrimitiveSource source{primitive, decode_draco_primitive(primitive, what)};
     if (source.draco) mode = TINYGLTF_MODE_TRIANGLES;  // the decoded faces are a triangle list
-    const PrimitiveVertices vertices = read_vertices(source, what);
+    PrimitiveVertices vertices = read_vertices(source, what);
+    add_morph_targets(primitive, placement.morph_weights, what, vertices);
     const std::size_t vertex_count = vertices.count();
     if (vertex_count > kMaxVertices - mesh_->positions.size()) fail(name_, "too many vertices");
     const std::vector<std::uint32_t> corners = triangle_corners(
@@ -563,7 +559,210 @@ class GltfMeshBuilder {
     const std::uint32_t material = primitive.material >= 0
                                        ? static_cast<std::uint32_t>(primitive.material)
                                        : default_material_;
-    place(vertices, corners, colors, material, world);
+    if (placement.skin_joints.empty()) {
+      for (const glm::dmat4& world : placement.worlds) {
+        place(vertices, corners, colors, material, world);
+      }
+    } else {
+      place(skinned(source, vertices, placement.skin_joints, what), corners, colors, material,
+            glm::dmat4(1.0));
+    }
+  }
+
+  /// How node `node_index`'s mesh is placed: skinned by its skin's joints (the node's own
+  /// transform then does not apply, glTF 2.0, 3.7.3.3), or once per EXT_mesh_gpu_instancing
+  /// instance, or once at the node.
+  Placement node_placement(int node_index) const {
+    const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
+    Placement placement;
+    if (node.skin >= 0) {
+      placement.skin_joints = joint_matrices(node.skin, node_index);
+      return placement;
+    }
+    const glm::dmat4& world = node_world_[static_cast<std::size_t>(node_index)];
+    const auto instancing = node.extensions.find(std::string(kInstancingExtension));
+    if (instancing == node.extensions.end()) {
+      placement.worlds.push_back(world);
+      return placement;
+    }
+    for (const glm::dmat4& instance : instance_transforms(instancing->second, node_index)) {
+      placement.worlds.push_back(world * instance);
+    }
+    return placement;
+  }
+
+  /// Skin `skin_index`'s joint matrices: globalTransform(joint_i) * inverseBindMatrix_i
+  /// (glTF 2.0, 3.7.3), the joints in the file's static pose.
+  std::vector<glm::dmat4> joint_matrices(int skin_index, int node_index) const {
+    const std::string what =
+        "node " + std::to_string(node_index) + ": skin " + std::to_string(skin_index);
+    if (static_cast<std::size_t>(skin_index) >= model_.skins.size()) {
+      fail(name_, what + " does not exist");
+    }
+    const tinygltf::Skin& skin = model_.skins[static_cast<std::size_t>(skin_index)];
+    if (skin.joints.empty()) fail(name_, what + " has no joints");
+    std::vector<double> inverse_binds;
+    if (skin.inverseBindMatrices >= 0) {
+      int components = 0;
+      inverse_binds = reader_.read_accessor(what + " inverseBindMatrices", skin.inverseBindMatrices,
+                                            components);
+      if (components != 16 || inverse_binds.size() / 16 < skin.joints.size()) {
+        fail(name_, what + ": inverseBindMatrices must be one MAT4 per joint");
+      }
+    }
+    std::vector<glm::dmat4> joints;
+    for (std::size_t i = 0; i < skin.joints.size(); ++i) {
+      const int joint = skin.joints[i];
+      if (joint < 0 || static_cast<std::size_t>(joint) >= reached_.size() ||
+          !reached_[static_cast<std::size_t>(joint)]) {
+        fail(name_, what + ": joint node " + std::to_string(joint) + " is not in the scene");
+      }
+      glm::dmat4 inverse_bind(1.0);
+      for (std::size_t k = 0; k < 16 && !inverse_binds.empty(); ++k) {
+        inverse_bind[static_cast<int>(k / 4)][static_cast<int>(k % 4)] = inverse_binds[16 * i + k];
+      }
+      joints.push_back(node_world_[static_cast<std::size_t>(joint)] * inverse_bind);
+    }
+    return joints;
+  }
+
+  /// EXT_mesh_gpu_instancing: one T * R * S per instance from the TRANSLATION, ROTATION
+  /// (quaternion) and SCALE accessors, each optional, all of one count.
+  std::vector<glm::dmat4> instance_transforms(const tinygltf::Value& extension,
+                                              int node_index) const {
+    const std::string what =
+        "node " + std::to_string(node_index) + ": " + std::string(kInstancingExtension);
+    if (!extension.IsObject() || !extension.Get("attributes").IsObject()) {
+      fail(name_, what + ": needs an attributes object");
+    }
+    const tinygltf::Value& attributes = extension.Get("attributes");
+    const std::vector<double> t = instance_attribute(attributes, "TRANSLATION", 3, what);
+    const std::vector<double> r = instance_attribute(attributes, "ROTATION", 4, what);
+    const std::vector<double> s = instance_attribute(attributes, "SCALE", 3, what);
+    const std::size_t count = std::max({t.size() / 3, r.size() / 4, s.size() / 3});
+    if ((!t.empty() && t.size() / 3 != count) || (!r.empty() && r.size() / 4 != count) ||
+        (!s.empty() && s.size() / 3 != count)) {
+      fail(name_, what + ": TRANSLATION, ROTATION and SCALE counts differ");
+    }
+    std::vector<glm::dmat4> instances(count, glm::dmat4(1.0));
+    for (std::size_t i = 0; i < count; ++i) {
+      glm::dmat4 translation(1.0), rotation(1.0), scale(1.0);
+      if (!t.empty()) translation[3] = glm::dvec4(t[3 * i], t[3 * i + 1], t[3 * i + 2], 1.0);
+      if (!r.empty())
+        rotation = rotation_matrix(r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]);
+      if (!s.empty()) {
+        scale[0][0] = s[3 * i];
+        scale[1][1] = s[3 * i + 1];
+        scale[2][2] = s[3 * i + 2];
+      }
+      instances[i] = translation * rotation * scale;
+    }
+    return instances;
+  }
+
+  /// One instancing attribute's values (`width` per instance), or empty when not given.
+  std::vector<double> instance_attribute(const tinygltf::Value& attributes, const char* key,
+                                         int width, const std::string& what) const {
+    if (!attributes.Has(key)) return {};
+    const tinygltf::Value& accessor = attributes.Get(key);
+    if (!accessor.IsInt()) fail(name_, what + ": " + key + " must be an accessor index");
+    int components = 0;
+    std::vector<double> values =
+        reader_.read_accessor(what + " " + key, accessor.GetNumberAsInt(), components);
+    if (components != width) {
+      fail(name_, what + ": " + key + (width == 3 ? " must be VEC3" : " must be VEC4"));
+    }
+    return values;
+  }
+
+  /// Adds the morph targets' POSITION and NORMAL deltas, each times its weight (glTF 2.0,
+  /// 3.7.2.2): p = p_0 + sum_i w_i * d_i. Targets of weight 0 are not read.
+  void add_morph_targets(const tinygltf::Primitive& primitive, const std::vector<double>& weights,
+                         const std::string& what, PrimitiveVertices& vertices) const {
+    if (primitive.targets.empty() || weights.empty()) return;
+    if (weights.size() != primitive.targets.size()) {
+      fail(name_, what + ": " + std::to_string(primitive.targets.size()) + " morph targets but " +
+                      std::to_string(weights.size()) + " weights");
+    }
+    for (std::size_t t = 0; t < primitive.targets.size(); ++t) {
+      if (weights[t] == 0.0) continue;
+      const std::string target = what + " target " + std::to_string(t);
+      add_delta(primitive.targets[t], "POSITION", weights[t], target, vertices.positions);
+      if (!vertices.normals.empty()) {
+        add_delta(primitive.targets[t], "NORMAL", weights[t], target, vertices.normals);
+      }
+    }
+  }
+
+  /// values += weight * the target's `attribute` (VEC3, one per vertex), when it has one.
+  void add_delta(const std::map<std::string, int>& target, const char* attribute, double weight,
+                 const std::string& what, std::vector<double>& values) const {
+    const auto it = target.find(attribute);
+    if (it == target.end()) return;
+    int components = 0;
+    const std::vector<double> delta =
+        reader_.read_accessor(what + " " + attribute, it->second, components);
+    if (components != 3 || delta.size() != values.size()) {
+      fail(name_, what + ": " + attribute + " must be VEC3 with one value per vertex");
+    }
+    for (std::size_t i = 0; i < values.size(); ++i) values[i] += weight * delta[i];
+  }
+
+  /// The vertices posed by the skin (glTF 2.0, 3.7.3.3, linear blend skinning): with
+  /// M = sum_i w_i * joints[j_i] over the JOINTS_n / WEIGHTS_n sets, p' = M p and
+  /// n' = M^-T n, in the file's world space.
+  PrimitiveVertices skinned(const PrimitiveSource& source, const PrimitiveVertices& vertices,
+                            const std::vector<glm::dmat4>& joints, const std::string& what) const {
+    const std::vector<glm::dmat4> skin =
+        vertex_skin_matrices(source, vertices.count(), joints, what);
+    PrimitiveVertices posed;
+    posed.positions.resize(vertices.positions.size());
+    posed.normals.resize(vertices.normals.size());
+    for (std::size_t v = 0; v < vertices.count(); ++v) {
+      const glm::dvec4 p =
+          skin[v] * glm::dvec4(vertices.positions[3 * v], vertices.positions[3 * v + 1],
+                               vertices.positions[3 * v + 2], 1.0);
+      for (int c = 0; c < 3; ++c) posed.positions[3 * v + static_cast<std::size_t>(c)] = p[c];
+      if (vertices.normals.empty()) continue;
+      const glm::dvec3 n = glm::transpose(glm::inverse(glm::dmat3(skin[v]))) *
+                           glm::dvec3(vertices.normals[3 * v], vertices.normals[3 * v + 1],
+                                      vertices.normals[3 * v + 2]);
+      for (int c = 0; c < 3; ++c) posed.normals[3 * v + static_cast<std::size_t>(c)] = n[c];
+    }
+    return posed;
+  }
+
+  /// Each vertex's skin matrix sum_i w_i * joints[j_i] from JOINTS_0/WEIGHTS_0,
+  /// JOINTS_1/WEIGHTS_1, ... (4 influences per set).
+  std::vector<glm::dmat4> vertex_skin_matrices(const PrimitiveSource& source,
+                                               std::size_t vertex_count,
+                                               const std::vector<glm::dmat4>& joints,
+                                               const std::string& what) const {
+    std::vector<glm::dmat4> skin(vertex_count, glm::dmat4(0.0));
+    for (int set = 0;; ++set) {
+      // Appended piecewise: "_" + std::to_string(set) trips a g++ 12 -Wrestrict false positive.
+      std::string suffix = "_";
+      suffix += std::to_string(set);
+      int joint_components = 0, weight_components = 0;
+      const auto joint_ids = attribute_values(source, "JOINTS" + suffix, what, joint_components);
+      const auto weights = attribute_values(source, "WEIGHTS" + suffix, what, weight_components);
+      if (!joint_ids && !weights) break;
+      if (!joint_ids || !weights || joint_components != 4 || weight_components != 4 ||
+          joint_ids->size() != 4 * vertex_count || weights->size() != 4 * vertex_count) {
+        fail(name_, what + ": JOINTS" + suffix + " and WEIGHTS" + suffix +
+                        " must both be VEC4 with one value per vertex");
+      }
+      for (std::size_t i = 0; i < 4 * vertex_count; ++i) {
+        if ((*weights)[i] == 0.0) continue;
+        if (!((*joint_ids)[i] < static_cast<double>(joints.size()))) {
+          fail(name_, what + ": joint " +
+                          std::to_string(static_cast<std::uint64_t>((*joint_ids)[i])) +
+                          " out of range (" + std::to_string(joints.size()) + " joints)");
+        }
+        skin[i / 4] += (*weights)[i] * joints[static_cast<std::size_t>((*joint_ids)[i])];
+      }
+    }
+    return skin;
   }
 
   /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
@@ -833,6 +1032,43 @@ class GltfMeshBuilder {
            "): covrast draws triangles only";
   }
 
+  /// The nodes of the trees under `roots` in depth-first file order; sets node_world_ (the
+  /// composed transforms) and reached_ for each.
+  std::vector<int> walk_nodes(const std::vector<int>& roots) {
+    struct Pending {
+      int node;
+      glm::dmat4 parent;
+    };
+    const std::size_t node_count = model_.nodes.size();
+    node_world_.assign(node_count, glm::dmat4(1.0));
+    reached_.assign(node_count, false);
+    std::vector<Pending> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
+      stack.push_back({*it, glm::dmat4(1.0)});
+    }
+    std::vector<int> order;
+    while (!stack.empty()) {
+      const Pending current = stack.back();
+      stack.pop_back();
+      if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
+        fail(name_, "node " + std::to_string(current.node) + " does not exist");
+      }
+      const auto node_index = static_cast<std::size_t>(current.node);
+      if (reached_[node_index]) {
+        fail(name_, "node " + std::to_string(current.node) +
+                        " is reached twice (the node hierarchy must be a tree)");
+      }
+      reached_[node_index] = true;
+      const tinygltf::Node& node = model_.nodes[node_index];
+      node_world_[node_index] = current.parent * local_transform(node, name_, current.node);
+      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
+        stack.push_back({*it, node_world_[node_index]});
+      }
+      order.push_back(current.node);
+    }
+    return order;
+  }
+
   const tinygltf::Model& model_;
   const std::string& name_;
   const Reader reader_;
@@ -840,6 +1076,8 @@ class GltfMeshBuilder {
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
+  std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
+  std::vector<bool> reached_;           ///< per node: in the walked scene
   /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per
   /// node that uses them.
   std::array<std::size_t, 4> undrawn_primitives_{};
