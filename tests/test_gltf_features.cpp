@@ -1,6 +1,7 @@
 // Tests of the glTF features beyond plain triangle lists (src/scene/mesh_gltf.cpp): strips and
 // fans, points and lines counted in a warning, extensionsRequired, KHR_draco_mesh_compression
-// (streams encoded here with libdraco), morph targets, skins and EXT_mesh_gpu_instancing. Every
+// (streams encoded here with libdraco), morph targets, skins, EXT_mesh_gpu_instancing and the
+// scene's camera from a glTF file. Every
 // file is written here by GltfBuilder (test_gltf_files.hpp); nothing is read from outside the test.
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
@@ -462,4 +463,101 @@ TEST_CASE("EXT_mesh_gpu_instancing draws the mesh once per instance", "[gltf]") 
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("counts.glb", b.glb())),
                       Contains("counts.glb: node 0: EXT_mesh_gpu_instancing: TRANSLATION, "
                                "ROTATION and SCALE counts differ"));
+}
+
+namespace {
+
+/// A red square [-1, 1]^2 at z = 0 (node 0); camera 0 (perspective, yfov 0.5, znear 0.5,
+/// zfar 50) at node 2, a child of node 1: node 1 moves by (0, 0, -5), node 2 by (0, 0, 10),
+/// so the camera is at (0, 0, 5) looking down -z at the square. Camera 1 is orthographic,
+/// camera 2 is on no node, camera 3 (at node 4, like camera 0) has no zfar.
+GltfBuilder camera_file() {
+  GltfBuilder b;
+  const int positions = b.add_floats({-1, -1, 0, 1, -1, 0, -1, 1, 0, 1, 1, 0}, "VEC3");
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 1}}}}}};
+  b.gltf["meshes"] = {
+      {{"primitives",
+        {{{"attributes", {{"POSITION", positions}}}, {"mode", 5}, {"material", 0}}}}}};
+  b.gltf["cameras"] = {
+      {{"type", "perspective"},
+       {"perspective", {{"yfov", 0.5}, {"znear", 0.5}, {"zfar", 50}, {"aspectRatio", 2.0}}}},
+      {{"type", "orthographic"},
+       {"orthographic", {{"xmag", 1}, {"ymag", 1}, {"znear", 0.5}, {"zfar", 50}}}},
+      {{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.5}, {"zfar", 50}}}},
+      {{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.5}}}}};
+  b.gltf["scenes"] = {{{"nodes", {0, 1}}}};
+  b.gltf["nodes"] = {{{"mesh", 0}},
+                     {{"translation", {0, 0, -5}}, {"children", {2, 3, 4}}},
+                     {{"translation", {0, 0, 10}}, {"camera", 0}},
+                     {{"camera", 1}},
+                     {{"translation", {0, 0, 10}}, {"camera", 3}}};
+  return b;
+}
+
+/// A scene of `meshes` (in that order) whose camera is {"gltf": `camera`}.
+json camera_scene(const json& camera, const json& meshes) {
+  return {{"width", 32}, {"height", 16}, {"camera", {{"gltf", camera}}}, {"meshes", meshes}};
+}
+
+}  // namespace
+
+TEST_CASE("a scene may take its camera from its first glTF mesh", "[gltf]") {
+  TempDir dir;
+  dir.write("cameras.glb", camera_file().glb());
+  dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const auto load = [&](const json& scene) {
+    std::ofstream(dir / "scene.json") << scene.dump();
+    return covrast::load_scene(dir / "scene.json");
+  };
+  // The first glTF entry (after an OBJ one) with its model matrix: a move by (0, 0, 1).
+  const json translated = {{"gltf", "cameras.glb"},
+                           {"model", {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 1}, {0, 0, 0, 1}}}};
+  const covrast::Scene scene =
+      load(camera_scene(0, {{{"obj", "tri.obj"}}, translated, {{"gltf", "cameras.glb"}}}));
+  REQUIRE(scene.camera.eye == glm::dvec3(0, 0, 6));  // (0,0,10) + (0,0,-5) + (0,0,1)
+  REQUIRE(scene.camera.target == glm::dvec3(0, 0, 5));
+  REQUIRE(scene.camera.up == glm::dvec3(0, 1, 0));
+  REQUIRE(scene.camera.fovy_deg == Approx(0.5 * 180 / 3.14159265358979323846));
+  REQUIRE(scene.camera.near == 0.5);
+  REQUIRE(scene.camera.far == 50.0);
+
+  // Without zfar (an infinite projection) the far plane lies beyond every mesh.
+  const covrast::Scene infinite = load(camera_scene(3, {{{"gltf", "cameras.glb"}}}));
+  REQUIRE(infinite.camera.far >= 2 * std::sqrt(2.0 + 25.0));
+
+  // The camera sees the red square filling the middle of the image; the image's size, not
+  // aspectRatio (2 here too), decides the aspect.
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode("coverage");
+  options.threads = 1;
+  const covrast::Image image = covrast::render(scene, options).color;
+  REQUIRE(image.pixel(16, 8)[0] == 255);
+  REQUIRE(image.pixel(16, 8)[1] == 0);
+  REQUIRE(image.pixel(0, 0)[0] == 0);  // tan(0.25) * 5 = 1.28 > 1: the corners are outside
+}
+
+TEST_CASE("bad glTF cameras are InputErrors naming the scene key and the camera", "[gltf]") {
+  TempDir dir;
+  dir.write("cameras.glb", camera_file().glb());
+  dir.write("tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  const json gltf_mesh = {{{"gltf", "cameras.glb"}}};
+  const std::vector<std::pair<json, std::string>> cases = {
+      {camera_scene(1, gltf_mesh),
+       "camera.gltf: camera 1 of 'cameras.glb' is orthographic: covrast renders perspective only"},
+      {camera_scene(2, gltf_mesh), "camera.gltf: camera 2 of 'cameras.glb' is on no node"},
+      {camera_scene(4, gltf_mesh),
+       "camera.gltf: camera 4 of 'cameras.glb' does not exist (4 "
+       "cameras)"},
+      {camera_scene(-1, gltf_mesh), "camera.gltf: expected a camera index >= 0, got -1"},
+      {camera_scene(0, {{{"obj", "tri.obj"}}}), "camera.gltf: the scene has no glTF mesh"},
+      {{{"width", 8},
+        {"height", 8},
+        {"camera", {{"gltf", 0}, {"fovy_deg", 40}}},
+        {"meshes", gltf_mesh}},
+       "camera: with \"gltf\" give no other camera key"}};
+  for (const auto& [scene, message] : cases) {
+    std::ofstream(dir / "scene.json") << scene.dump();
+    REQUIRE_THROWS_WITH(covrast::load_scene(dir / "scene.json"),
+                        Contains("scene.json: " + message));
+  }
 }

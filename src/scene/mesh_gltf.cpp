@@ -362,6 +362,22 @@ Material convert_material(const tinygltf::Material& source) {
   return m;
 }
 
+/// A glTF camera's projection (glTF 2.0, 3.10.2); aspectRatio is not kept: the image's
+/// width and height decide it.
+FileCamera file_camera(const tinygltf::Camera& camera) {
+  FileCamera out;
+  out.orthographic = camera.type == "orthographic";
+  if (out.orthographic) {
+    out.znear = camera.orthographic.znear;
+    out.zfar = camera.orthographic.zfar;
+  } else {
+    out.yfov_rad = camera.perspective.yfov;
+    out.znear = camera.perspective.znear;
+    out.zfar = camera.perspective.zfar;
+  }
+  return out;
+}
+
 /// Normals of one primitive in the node's world space: n_world = normalize(M^-T n) for the
 /// upper 3x3 M of the node's matrix (normals are covectors).
 std::vector<glm::vec3> world_normals(const std::vector<double>& values, const glm::dmat4& world) {
@@ -480,6 +496,7 @@ class GltfMeshBuilder {
     }
     mesh_->materials.push_back(convert_material(tinygltf::Material{}));
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
+    for (const tinygltf::Camera& camera : model.cameras) cameras_.push_back(file_camera(camera));
   }
 
   /// Walks the node trees under `roots` depth first, in file order, composing the node
@@ -488,11 +505,13 @@ class GltfMeshBuilder {
     for (const int node_index : walk_nodes(roots)) {
       const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
       if (node.mesh >= 0) add_mesh(node_index, node.mesh, node_placement(node_index));
+      if (node.camera >= 0) place_camera(node_index, node.camera);
     }
   }
 
   LoadedMesh finish() {
     LoadedMesh loaded;
+    loaded.cameras = std::move(cameras_);
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
@@ -567,6 +586,18 @@ class GltfMeshBuilder {
       place(skinned(source, vertices, placement.skin_joints, what), corners, colors, material,
             glm::dmat4(1.0));
     }
+  }
+
+  /// Camera `camera_index` at node `node_index`, unless an earlier node placed it.
+  void place_camera(int node_index, int camera_index) {
+    if (static_cast<std::size_t>(camera_index) >= cameras_.size()) {
+      fail(name_, "node " + std::to_string(node_index) + ": camera " +
+                      std::to_string(camera_index) + " does not exist");
+    }
+    FileCamera& camera = cameras_[static_cast<std::size_t>(camera_index)];
+    if (camera.placed) return;
+    camera.placed = true;
+    camera.world = node_world_[static_cast<std::size_t>(node_index)];
   }
 
   /// How node `node_index`'s mesh is placed: skinned by its skin's joints (the node's own
@@ -1076,6 +1107,7 @@ class GltfMeshBuilder {
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
+  std::vector<FileCamera> cameras_;
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
   std::vector<bool> reached_;           ///< per node: in the walked scene
   /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per
