@@ -1,8 +1,11 @@
 // glTF 2.0 reader (.gltf with embedded or external buffers, .glb) on top of tinygltf. Collects
 // every triangle primitive (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN) of every mesh reachable
 // from the default scene (scene 0 when none is marked, every root node when the file has no
-// scene at all), bakes the node transforms (matrix, or T * R * S) into the positions, and
-// COLOR_0 x baseColorFactor into colors_linear; points and lines are counted in a warning.
+// scene at all), posed in the file's static pose: morph targets at their default weights,
+// skins by their joints' node transforms, EXT_mesh_gpu_instancing instances; bakes the node
+// transforms (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into
+// colors_linear. Points and lines are counted in a warning; Draco streams are decoded by
+// gltf_draco.cpp; the file's cameras are kept for the scene (FileCamera).
 // glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
 // bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
 #include "scene/gltf_draco.hpp"
@@ -534,8 +537,9 @@ class GltfMeshBuilder {
   }
 
  private:
-  /// Mesh `mesh_index` of node `node_index`, with the node's world transform. Primitives of
-  /// the point and line modes are counted (LoadedMesh::warnings), not drawn.
+  /// Mesh `mesh_index` of node `node_index`, placed by `placement` with the node's morph
+  /// weights. Primitives of the point and line modes are counted (LoadedMesh::warnings), not
+  /// drawn.
   void add_mesh(int node_index, int mesh_index, Placement placement) {
     if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size()) {
       fail(name_, "node " + std::to_string(node_index) + ": mesh " + std::to_string(mesh_index) +
