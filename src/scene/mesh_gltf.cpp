@@ -6,20 +6,19 @@
 // transforms (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into
 // colors_linear. Points and lines are counted in a warning; Draco streams are decoded by
 // gltf_draco.cpp; the file's cameras are kept for the scene (FileCamera).
-// glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
-// bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
+// glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access goes
+// through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
+#include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
+#include "scene/gltf_pose.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <tiny_gltf.h>
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <climits>
 #include <cmath>
-#include <cstring>
-#include <limits>
 #include <map>
 #include <optional>
 #include <string_view>
@@ -27,16 +26,6 @@
 
 namespace covrast::detail {
 namespace {
-
-static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
-
-constexpr std::size_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
-/// Accessors without a bufferView are all zeros (plus sparse values): cap what they allocate.
-constexpr std::size_t kMaxUnbackedElements = std::size_t{1} << 26;
-
-[[noreturn]] void fail(const std::string& name, const std::string& message) {
-  throw InputError(name + ": " + message);
-}
 
 /// tinygltf's messages can span several lines and quote raw bytes; ours are one printable
 /// line. A JSON syntax error ("... parse error at line L, column C: detail") becomes
@@ -69,218 +58,6 @@ std::string loader_error_message(const std::string& name, std::string text) {
     }
   }
   return out;
-}
-
-/// `text` with every byte outside printable ASCII shown as '?' (messages are one line).
-std::string printable(std::string text) {
-  for (char& c : text) {
-    const auto byte = static_cast<unsigned char>(c);
-    if (byte < 0x20 || byte >= 0x7f) c = '?';
-  }
-  return text;
-}
-
-int component_size_bytes(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-int component_count(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    case TINYGLTF_TYPE_MAT4:
-      return 16;
-    default:
-      return 0;
-  }
-}
-
-template <typename T>
-T load(const unsigned char* bytes) {
-  T value;
-  std::memcpy(&value, bytes, sizeof value);
-  return value;
-}
-
-/// One component; normalized integers map to [0, 1] or [-1, 1] (glTF 2.0 spec, 3.11).
-double read_component(const unsigned char* bytes, int component_type, bool normalized) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const double v = load<std::int8_t>(bytes);
-      return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-      const double v = load<std::uint8_t>(bytes);
-      return normalized ? v / 255.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      const double v = load<std::int16_t>(bytes);
-      return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      const double v = load<std::uint16_t>(bytes);
-      return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-      return load<std::uint32_t>(bytes);
-    default:
-      return load<float>(bytes);
-  }
-}
-
-struct Reader {
-  const tinygltf::Model& model;
-  const std::string& name;
-
-  /// The first byte of buffer view `view_index`, checked to lie with its byteLength bytes
-  /// inside its buffer.
-  const unsigned char* view_bytes(const std::string& what, int view_index) const {
-    if (view_index < 0 || static_cast<std::size_t>(view_index) >= model.bufferViews.size()) {
-      fail(name, what + ": bufferView " + std::to_string(view_index) + " does not exist");
-    }
-    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(view_index)];
-    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size()) {
-      fail(name, what + ": buffer " + std::to_string(view.buffer) + " does not exist");
-    }
-    const std::vector<unsigned char>& data =
-        model.buffers[static_cast<std::size_t>(view.buffer)].data;
-    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
-      fail(name, what + ": bufferView " + std::to_string(view_index) + " exceeds its buffer");
-    }
-    return data.data() + view.byteOffset;
-  }
-
-  /// Reads `count` elements of `components` components from a buffer view into `out`.
-  /// `strided`: honour the view's byteStride (vertex attributes), else tightly packed.
-  void read_view(const std::string& what, int view_index, std::size_t byte_offset,
-                 std::size_t count, int component_type, int components, bool normalized,
-                 bool strided, double* out) const {
-    const unsigned char* view_begin = view_bytes(what, view_index);
-    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(view_index)];
-    if (count == 0) return;
-    const std::size_t element_bytes =
-        static_cast<std::size_t>(component_size_bytes(component_type)) *
-        static_cast<std::size_t>(components);
-    const std::size_t stride = strided && view.byteStride != 0 ? view.byteStride : element_bytes;
-    if (stride < element_bytes) fail(name, what + ": byteStride smaller than one element");
-    // Last element must end inside the view: offset + stride * (count - 1) + element <= length.
-    if (byte_offset > view.byteLength || view.byteLength - byte_offset < element_bytes ||
-        count - 1 > (view.byteLength - byte_offset - element_bytes) / stride) {
-      fail(name,
-           what + ": accessor reads past the end of bufferView " + std::to_string(view_index));
-    }
-    const unsigned char* base = view_begin + byte_offset;
-    const std::size_t size = static_cast<std::size_t>(component_size_bytes(component_type));
-    for (std::size_t i = 0; i < count; ++i) {
-      for (int c = 0; c < components; ++c) {
-        out[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
-            read_component(base + i * stride + static_cast<std::size_t>(c) * size, component_type,
-                           normalized);
-      }
-    }
-  }
-
-  /// Reads a whole accessor (including sparse substitution) as doubles, `components` per
-  /// element; `components` receives the element width.
-  std::vector<double> read_accessor(const std::string& what, int accessor_index,
-                                    int& components) const {
-    if (accessor_index < 0 || static_cast<std::size_t>(accessor_index) >= model.accessors.size()) {
-      fail(name, what + ": accessor " + std::to_string(accessor_index) + " does not exist");
-    }
-    const tinygltf::Accessor& accessor = model.accessors[static_cast<std::size_t>(accessor_index)];
-    components = component_count(accessor.type);
-    if (components == 0 || component_size_bytes(accessor.componentType) == 0) {
-      fail(name, what + ": unsupported accessor type or component type");
-    }
-    const auto width = static_cast<std::size_t>(components);
-    if (accessor.bufferView < 0 && accessor.count > kMaxUnbackedElements) {
-      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
-    }
-    if (accessor.bufferView >= 0 && accessor.count > kMaxVertices) {
-      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
-    }
-    std::vector<double> values;
-    if (accessor.bufferView >= 0) {
-      // Validate the view before allocating: it must hold count elements of >= 1 byte.
-      read_view(what, accessor.bufferView, accessor.byteOffset, 0, accessor.componentType,
-                components, accessor.normalized, true, nullptr);
-      const tinygltf::BufferView& view =
-          model.bufferViews[static_cast<std::size_t>(accessor.bufferView)];
-      if (accessor.count > view.byteLength) {
-        fail(name, what + ": accessor reads past the end of bufferView " +
-                       std::to_string(accessor.bufferView));
-      }
-      values.resize(accessor.count * width);
-      read_view(what, accessor.bufferView, accessor.byteOffset, accessor.count,
-                accessor.componentType, components, accessor.normalized, true, values.data());
-    } else {
-      values.assign(accessor.count * width, 0.0);
-    }
-    if (accessor.sparse.isSparse) {
-      const auto& sparse = accessor.sparse;
-      if (sparse.count < 0 || static_cast<std::size_t>(sparse.count) > accessor.count ||
-          sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0) {
-        fail(name, what + ": bad sparse accessor");
-      }
-      const int index_type = sparse.indices.componentType;
-      if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-        fail(name, what + ": bad sparse index component type");
-      }
-      const auto sparse_count = static_cast<std::size_t>(sparse.count);
-      std::vector<double> targets(sparse_count);
-      std::vector<double> replacements(sparse_count * width);
-      read_view(what + " (sparse indices)", sparse.indices.bufferView,
-                static_cast<std::size_t>(sparse.indices.byteOffset), sparse_count, index_type, 1,
-                false, false, targets.data());
-      read_view(what + " (sparse values)", sparse.values.bufferView,
-                static_cast<std::size_t>(sparse.values.byteOffset), sparse_count,
-                accessor.componentType, components, accessor.normalized, false,
-                replacements.data());
-      for (std::size_t i = 0; i < sparse_count; ++i) {
-        const auto target = static_cast<std::size_t>(targets[i]);
-        if (target >= accessor.count) fail(name, what + ": sparse index out of range");
-        std::copy_n(replacements.begin() + static_cast<std::ptrdiff_t>(i * width), width,
-                    values.begin() + static_cast<std::ptrdiff_t>(target * width));
-      }
-    }
-    return values;
-  }
-};
-
-/// Unit quaternion (x, y, z, w) -> rotation matrix; normalised first for robustness.
-glm::dmat4 rotation_matrix(double x, double y, double z, double w) {
-  const double length = std::sqrt(x * x + y * y + z * z + w * w);
-  if (length > 0.0) {
-    x /= length;
-    y /= length;
-    z /= length;
-    w /= length;
-  }
-  glm::dmat4 r(1.0);
-  r[0] = glm::dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0);
-  r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0);
-  r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0);
-  return r;
 }
 
 /// Node-local transform: the matrix when given (column-major, like GLM), else T * R * S.
@@ -462,13 +239,6 @@ std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& nam
   return roots;
 }
 
-/// A primitive's vertex data as the file gives it, before placement.
-struct PrimitiveVertices {
-  std::vector<double> positions;  ///< object space, 3 per vertex
-  std::vector<double> normals;    ///< object space, 3 per vertex; empty without NORMAL
-  std::size_t count() const { return positions.size() / 3; }
-};
-
 /// Where a primitive's attributes come from: its accessors, or its decoded Draco stream.
 struct PrimitiveSource {
   const tinygltf::Primitive& primitive;
@@ -481,8 +251,6 @@ struct Placement {
   std::vector<glm::dmat4> skin_joints;  ///< skinned: the joint matrices, `worlds` unused
   std::vector<double> morph_weights;    ///< the node's weights, else the mesh's
 };
-
-inline constexpr std::string_view kInstancingExtension = "EXT_mesh_gpu_instancing";
 
 /// Collects the triangle primitives of the node tree into one MeshData: positions, indices,
 /// materials and normals as it goes, and the colours with what decides between vertex
@@ -573,7 +341,7 @@ class GltfMeshBuilder {
     const PrimitiveSource source{primitive, decode_draco_primitive(primitive, what)};
     if (source.draco) mode = TINYGLTF_MODE_TRIANGLES;  // the decoded faces are a triangle list
     PrimitiveVertices vertices = read_vertices(source, what);
-    add_morph_targets(primitive, placement.morph_weights, what, vertices);
+    add_morph_targets(reader_, primitive, placement.morph_weights, what, vertices);
     const std::size_t vertex_count = vertices.count();
     if (vertex_count > kMaxVertices - mesh_->positions.size()) fail(name_, "too many vertices");
     const std::vector<std::uint32_t> corners = triangle_corners(
@@ -587,8 +355,10 @@ class GltfMeshBuilder {
         place(vertices, corners, colors, material, world);
       }
     } else {
-      place(skinned(source, vertices, placement.skin_joints, what), corners, colors, material,
-            glm::dmat4(1.0));
+      const std::vector<glm::dmat4> skin =
+          vertex_skin_matrices(skin_influences(source, vertices.count(), what), vertices.count(),
+                               placement.skin_joints, name_, what);
+      place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0));
     }
   }
 
@@ -611,7 +381,7 @@ class GltfMeshBuilder {
     const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
     Placement placement;
     if (node.skin >= 0) {
-      placement.skin_joints = joint_matrices(node.skin, node_index);
+      placement.skin_joints = joint_matrices(reader_, node.skin, node_index, node_world_, reached_);
       return placement;
     }
     const glm::dmat4& world = node_world_[static_cast<std::size_t>(node_index)];
@@ -620,184 +390,33 @@ class GltfMeshBuilder {
       placement.worlds.push_back(world);
       return placement;
     }
-    for (const glm::dmat4& instance : instance_transforms(instancing->second, node_index)) {
+    for (const glm::dmat4& instance :
+         instance_transforms(reader_, instancing->second, node_index)) {
       placement.worlds.push_back(world * instance);
     }
     return placement;
   }
 
-  /// Skin `skin_index`'s joint matrices: globalTransform(joint_i) * inverseBindMatrix_i
-  /// (glTF 2.0, 3.7.3), the joints in the file's static pose.
-  std::vector<glm::dmat4> joint_matrices(int skin_index, int node_index) const {
-    const std::string what =
-        "node " + std::to_string(node_index) + ": skin " + std::to_string(skin_index);
-    if (static_cast<std::size_t>(skin_index) >= model_.skins.size()) {
-      fail(name_, what + " does not exist");
-    }
-    const tinygltf::Skin& skin = model_.skins[static_cast<std::size_t>(skin_index)];
-    if (skin.joints.empty()) fail(name_, what + " has no joints");
-    std::vector<double> inverse_binds;
-    if (skin.inverseBindMatrices >= 0) {
-      int components = 0;
-      inverse_binds = reader_.read_accessor(what + " inverseBindMatrices", skin.inverseBindMatrices,
-                                            components);
-      if (components != 16 || inverse_binds.size() / 16 < skin.joints.size()) {
-        fail(name_, what + ": inverseBindMatrices must be one MAT4 per joint");
-      }
-    }
-    std::vector<glm::dmat4> joints;
-    for (std::size_t i = 0; i < skin.joints.size(); ++i) {
-      const int joint = skin.joints[i];
-      if (joint < 0 || static_cast<std::size_t>(joint) >= reached_.size() ||
-          !reached_[static_cast<std::size_t>(joint)]) {
-        fail(name_, what + ": joint node " + std::to_string(joint) + " is not in the scene");
-      }
-      glm::dmat4 inverse_bind(1.0);
-      for (std::size_t k = 0; k < 16 && !inverse_binds.empty(); ++k) {
-        inverse_bind[static_cast<int>(k / 4)][static_cast<int>(k % 4)] = inverse_binds[16 * i + k];
-      }
-      joints.push_back(node_world_[static_cast<std::size_t>(joint)] * inverse_bind);
-    }
-    return joints;
-  }
-
-  /// EXT_mesh_gpu_instancing: one T * R * S per instance from the TRANSLATION, ROTATION
-  /// (quaternion) and SCALE accessors, each optional, all of one count.
-  std::vector<glm::dmat4> instance_transforms(const tinygltf::Value& extension,
-                                              int node_index) const {
-    const std::string what =
-        "node " + std::to_string(node_index) + ": " + std::string(kInstancingExtension);
-    if (!extension.IsObject() || !extension.Get("attributes").IsObject()) {
-      fail(name_, what + ": needs an attributes object");
-    }
-    const tinygltf::Value& attributes = extension.Get("attributes");
-    const std::vector<double> t = instance_attribute(attributes, "TRANSLATION", 3, what);
-    const std::vector<double> r = instance_attribute(attributes, "ROTATION", 4, what);
-    const std::vector<double> s = instance_attribute(attributes, "SCALE", 3, what);
-    const std::size_t count = std::max({t.size() / 3, r.size() / 4, s.size() / 3});
-    if ((!t.empty() && t.size() / 3 != count) || (!r.empty() && r.size() / 4 != count) ||
-        (!s.empty() && s.size() / 3 != count)) {
-      fail(name_, what + ": TRANSLATION, ROTATION and SCALE counts differ");
-    }
-    std::vector<glm::dmat4> instances(count, glm::dmat4(1.0));
-    for (std::size_t i = 0; i < count; ++i) {
-      glm::dmat4 translation(1.0), rotation(1.0), scale(1.0);
-      if (!t.empty()) translation[3] = glm::dvec4(t[3 * i], t[3 * i + 1], t[3 * i + 2], 1.0);
-      if (!r.empty())
-        rotation = rotation_matrix(r[4 * i], r[4 * i + 1], r[4 * i + 2], r[4 * i + 3]);
-      if (!s.empty()) {
-        scale[0][0] = s[3 * i];
-        scale[1][1] = s[3 * i + 1];
-        scale[2][2] = s[3 * i + 2];
-      }
-      instances[i] = translation * rotation * scale;
-    }
-    return instances;
-  }
-
-  /// One instancing attribute's values (`width` per instance), or empty when not given.
-  std::vector<double> instance_attribute(const tinygltf::Value& attributes, const char* key,
-                                         int width, const std::string& what) const {
-    if (!attributes.Has(key)) return {};
-    const tinygltf::Value& accessor = attributes.Get(key);
-    if (!accessor.IsInt()) fail(name_, what + ": " + key + " must be an accessor index");
-    int components = 0;
-    std::vector<double> values =
-        reader_.read_accessor(what + " " + key, accessor.GetNumberAsInt(), components);
-    if (components != width) {
-      fail(name_, what + ": " + key + (width == 3 ? " must be VEC3" : " must be VEC4"));
-    }
-    return values;
-  }
-
-  /// Adds the morph targets' POSITION and NORMAL deltas, each times its weight (glTF 2.0,
-  /// 3.7.2.2): p = p_0 + sum_i w_i * d_i. Targets of weight 0 are not read.
-  void add_morph_targets(const tinygltf::Primitive& primitive, const std::vector<double>& weights,
-                         const std::string& what, PrimitiveVertices& vertices) const {
-    if (primitive.targets.empty() || weights.empty()) return;
-    if (weights.size() != primitive.targets.size()) {
-      fail(name_, what + ": " + std::to_string(primitive.targets.size()) + " morph targets but " +
-                      std::to_string(weights.size()) + " weights");
-    }
-    for (std::size_t t = 0; t < primitive.targets.size(); ++t) {
-      if (weights[t] == 0.0) continue;
-      const std::string target = what + " target " + std::to_string(t);
-      add_delta(primitive.targets[t], "POSITION", weights[t], target, vertices.positions);
-      if (!vertices.normals.empty()) {
-        add_delta(primitive.targets[t], "NORMAL", weights[t], target, vertices.normals);
-      }
-    }
-  }
-
-  /// values += weight * the target's `attribute` (VEC3, one per vertex), when it has one.
-  void add_delta(const std::map<std::string, int>& target, const char* attribute, double weight,
-                 const std::string& what, std::vector<double>& values) const {
-    const auto it = target.find(attribute);
-    if (it == target.end()) return;
-    int components = 0;
-    const std::vector<double> delta =
-        reader_.read_accessor(what + " " + attribute, it->second, components);
-    if (components != 3 || delta.size() != values.size()) {
-      fail(name_, what + ": " + attribute + " must be VEC3 with one value per vertex");
-    }
-    for (std::size_t i = 0; i < values.size(); ++i) values[i] += weight * delta[i];
-  }
-
-  /// The vertices posed by the skin (glTF 2.0, 3.7.3.3, linear blend skinning): with
-  /// M = sum_i w_i * joints[j_i] over the JOINTS_n / WEIGHTS_n sets, p' = M p and
-  /// n' = M^-T n, in the file's world space.
-  PrimitiveVertices skinned(const PrimitiveSource& source, const PrimitiveVertices& vertices,
-                            const std::vector<glm::dmat4>& joints, const std::string& what) const {
-    const std::vector<glm::dmat4> skin =
-        vertex_skin_matrices(source, vertices.count(), joints, what);
-    PrimitiveVertices posed;
-    posed.positions.resize(vertices.positions.size());
-    posed.normals.resize(vertices.normals.size());
-    for (std::size_t v = 0; v < vertices.count(); ++v) {
-      const glm::dvec4 p =
-          skin[v] * glm::dvec4(vertices.positions[3 * v], vertices.positions[3 * v + 1],
-                               vertices.positions[3 * v + 2], 1.0);
-      for (int c = 0; c < 3; ++c) posed.positions[3 * v + static_cast<std::size_t>(c)] = p[c];
-      if (vertices.normals.empty()) continue;
-      const glm::dvec3 n = glm::transpose(glm::inverse(glm::dmat3(skin[v]))) *
-                           glm::dvec3(vertices.normals[3 * v], vertices.normals[3 * v + 1],
-                                      vertices.normals[3 * v + 2]);
-      for (int c = 0; c < 3; ++c) posed.normals[3 * v + static_cast<std::size_t>(c)] = n[c];
-    }
-    return posed;
-  }
-
-  /// Each vertex's skin matrix sum_i w_i * joints[j_i] from JOINTS_0/WEIGHTS_0,
-  /// JOINTS_1/WEIGHTS_1, ... (4 influences per set).
-  std::vector<glm::dmat4> vertex_skin_matrices(const PrimitiveSource& source,
-                                               std::size_t vertex_count,
-                                               const std::vector<glm::dmat4>& joints,
-                                               const std::string& what) const {
-    std::vector<glm::dmat4> skin(vertex_count, glm::dmat4(0.0));
+  /// The primitive's JOINTS_0 / WEIGHTS_0, JOINTS_1 / WEIGHTS_1, ... sets (glTF 2.0, 3.7.3.3).
+  std::vector<SkinInfluences> skin_influences(const PrimitiveSource& source,
+                                              std::size_t vertex_count,
+                                              const std::string& what) const {
+    std::vector<SkinInfluences> sets;
     for (int set = 0;; ++set) {
       // Appended piecewise: "_" + std::to_string(set) trips a g++ 12 -Wrestrict false positive.
       std::string suffix = "_";
       suffix += std::to_string(set);
       int joint_components = 0, weight_components = 0;
-      const auto joint_ids = attribute_values(source, "JOINTS" + suffix, what, joint_components);
-      const auto weights = attribute_values(source, "WEIGHTS" + suffix, what, weight_components);
-      if (!joint_ids && !weights) break;
-      if (!joint_ids || !weights || joint_components != 4 || weight_components != 4 ||
-          joint_ids->size() != 4 * vertex_count || weights->size() != 4 * vertex_count) {
+      auto joints = attribute_values(source, "JOINTS" + suffix, what, joint_components);
+      auto weights = attribute_values(source, "WEIGHTS" + suffix, what, weight_components);
+      if (!joints && !weights) return sets;
+      if (!joints || !weights || joint_components != 4 || weight_components != 4 ||
+          joints->size() != 4 * vertex_count || weights->size() != 4 * vertex_count) {
         fail(name_, what + ": JOINTS" + suffix + " and WEIGHTS" + suffix +
                         " must both be VEC4 with one value per vertex");
       }
-      for (std::size_t i = 0; i < 4 * vertex_count; ++i) {
-        if ((*weights)[i] == 0.0) continue;
-        if (!((*joint_ids)[i] < static_cast<double>(joints.size()))) {
-          fail(name_, what + ": joint " +
-                          std::to_string(static_cast<std::uint64_t>((*joint_ids)[i])) +
-                          " out of range (" + std::to_string(joints.size()) + " joints)");
-        }
-        skin[i / 4] += (*weights)[i] * joints[static_cast<std::size_t>((*joint_ids)[i])];
-      }
+      sets.push_back({std::move(*joints), std::move(*weights)});
     }
-    return skin;
   }
 
   /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
@@ -1106,7 +725,7 @@ class GltfMeshBuilder {
 
   const tinygltf::Model& model_;
   const std::string& name_;
-  const Reader reader_;
+  const GltfReader reader_;
   std::shared_ptr<MeshData> mesh_;
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
