@@ -39,11 +39,10 @@ LIGHT_RIG = [
 
 
 def find_model_file(folder):
-    """The model's .gltf or .glb: from glTF/, else glTF-Binary/, else any other variant folder
-    but glTF-Draco (not decoded yet); None if there is none."""
+    """The model's .gltf or .glb: from glTF/, else glTF-Binary/, else any other variant folder;
+    None if there is none."""
     variants = ["glTF", "glTF-Binary"] + sorted(
-        v for v in os.listdir(folder) if v.startswith("glTF-") and v not in
-        ("glTF-Binary", "glTF-Draco"))
+        v for v in os.listdir(folder) if v.startswith("glTF-") and v != "glTF-Binary")
     for variant in variants:
         directory = os.path.join(folder, variant)
         if not os.path.isdir(directory):

@@ -21,6 +21,7 @@
 
 #include <unistd.h>
 
+#include "test_gltf_files.hpp"
 #include "test_tempdir.hpp"
 
 namespace fs = std::filesystem;
@@ -28,6 +29,11 @@ using Catch::Matchers::Contains;
 using covrast::ColorSource;
 using covrast::InputError;
 using covrast::srgb_to_linear;
+using covrast::test::base64;
+using covrast::test::make_glb;
+using covrast::test::put_f32;
+using covrast::test::put_u16;
+using covrast::test::put_u8;
 using nlohmann::json;
 
 namespace {
@@ -76,68 +82,6 @@ json valid_scene() {
                "fovy_deg": 45.0, "near": 0.5, "far": 10.0},
     "meshes": [{"obj": "tri.obj"}]
   })");
-}
-
-// ---- little-endian byte packing and base64 for the hand-written glTF files ----
-
-void put_f32(std::string& out, float value) {
-  char bytes[4];
-  std::memcpy(bytes, &value, 4);
-  out.append(bytes, 4);
-}
-void put_u32(std::string& out, std::uint32_t value) {
-  for (int i = 0; i < 4; ++i) out += static_cast<char>((value >> (8 * i)) & 255u);
-}
-void put_u16(std::string& out, std::uint16_t value) {
-  out += static_cast<char>(value & 255u);
-  out += static_cast<char>(value >> 8);
-}
-void put_u8(std::string& out, std::uint8_t value) { out += static_cast<char>(value); }
-
-std::string base64(const std::string& data) {
-  static const char* const kAlphabet =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out;
-  std::size_t i = 0;
-  for (; i + 2 < data.size(); i += 3) {
-    const std::uint32_t n = (std::uint32_t(std::uint8_t(data[i])) << 16) |
-                            (std::uint32_t(std::uint8_t(data[i + 1])) << 8) |
-                            std::uint32_t(std::uint8_t(data[i + 2]));
-    out += kAlphabet[(n >> 18) & 63];
-    out += kAlphabet[(n >> 12) & 63];
-    out += kAlphabet[(n >> 6) & 63];
-    out += kAlphabet[n & 63];
-  }
-  if (i + 1 == data.size()) {
-    const std::uint32_t n = std::uint32_t(std::uint8_t(data[i])) << 16;
-    out += kAlphabet[(n >> 18) & 63];
-    out += kAlphabet[(n >> 12) & 63];
-    out += "==";
-  } else if (i + 2 == data.size()) {
-    const std::uint32_t n = (std::uint32_t(std::uint8_t(data[i])) << 16) |
-                            (std::uint32_t(std::uint8_t(data[i + 1])) << 8);
-    out += kAlphabet[(n >> 18) & 63];
-    out += kAlphabet[(n >> 12) & 63];
-    out += kAlphabet[(n >> 6) & 63];
-    out += '=';
-  }
-  return out;
-}
-
-/// Binary glTF container: 12-byte header, JSON chunk (space padded), BIN chunk (zero padded).
-std::string make_glb(std::string json_text, std::string bin) {
-  while (json_text.size() % 4 != 0) json_text += ' ';
-  while (bin.size() % 4 != 0) bin += '\0';
-  std::string out = "glTF";
-  put_u32(out, 2);
-  put_u32(out, static_cast<std::uint32_t>(12 + 8 + json_text.size() + 8 + bin.size()));
-  put_u32(out, static_cast<std::uint32_t>(json_text.size()));
-  put_u32(out, 0x4E4F534Au);  // "JSON"
-  out += json_text;
-  put_u32(out, static_cast<std::uint32_t>(bin.size()));
-  put_u32(out, 0x004E4942u);  // "BIN\0"
-  out += bin;
-  return out;
 }
 
 }  // namespace

@@ -1,33 +1,31 @@
 // glTF 2.0 reader (.gltf with embedded or external buffers, .glb) on top of tinygltf. Collects
-// every mode-TRIANGLES primitive of every mesh reachable from the default scene (scene 0 when
-// none is marked, every root node when the file has no scene at all), bakes the node transforms
-// (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into colors_linear.
-// glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access is
-// bounds-checked here rather than trusted, so a broken file is an InputError and never a crash.
+// every triangle primitive (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN) of every mesh reachable
+// from the default scene (scene 0 when none is marked, every root node when the file has no
+// scene at all), posed in the file's static pose: morph targets at their default weights,
+// skins by their joints' node transforms, EXT_mesh_gpu_instancing instances; bakes the node
+// transforms (matrix, or T * R * S) into the positions, and COLOR_0 x baseColorFactor into
+// colors_linear. Points and lines are counted in a warning; Draco streams are decoded by
+// gltf_draco.cpp; the file's cameras are kept for the scene (FileCamera).
+// glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access goes
+// through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
+#include "scene/gltf_accessors.hpp"
+#include "scene/gltf_draco.hpp"
+#include "scene/gltf_pose.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <tiny_gltf.h>
 
 #include <algorithm>
-#include <bit>
+#include <array>
 #include <climits>
 #include <cmath>
-#include <cstring>
-#include <limits>
+#include <map>
+#include <optional>
+#include <string_view>
 #include <vector>
 
 namespace covrast::detail {
 namespace {
-
-static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
-
-constexpr std::size_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
-/// Accessors without a bufferView are all zeros (plus sparse values): cap what they allocate.
-constexpr std::size_t kMaxUnbackedElements = std::size_t{1} << 26;
-
-[[noreturn]] void fail(const std::string& name, const std::string& message) {
-  throw InputError(name + ": " + message);
-}
 
 /// tinygltf's messages can span several lines and quote raw bytes; ours are one printable
 /// line. A JSON syntax error ("... parse error at line L, column C: detail") becomes
@@ -62,183 +60,6 @@ std::string loader_error_message(const std::string& name, std::string text) {
   return out;
 }
 
-int component_size_bytes(int component_type) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE:
-      return 1;
-    case TINYGLTF_COMPONENT_TYPE_SHORT:
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT:
-      return 2;
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-    case TINYGLTF_COMPONENT_TYPE_FLOAT:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-int component_count(int type) {
-  switch (type) {
-    case TINYGLTF_TYPE_SCALAR:
-      return 1;
-    case TINYGLTF_TYPE_VEC2:
-      return 2;
-    case TINYGLTF_TYPE_VEC3:
-      return 3;
-    case TINYGLTF_TYPE_VEC4:
-      return 4;
-    default:
-      return 0;
-  }
-}
-
-template <typename T>
-T load(const unsigned char* bytes) {
-  T value;
-  std::memcpy(&value, bytes, sizeof value);
-  return value;
-}
-
-/// One component; normalized integers map to [0, 1] or [-1, 1] (glTF 2.0 spec, 3.11).
-double read_component(const unsigned char* bytes, int component_type, bool normalized) {
-  switch (component_type) {
-    case TINYGLTF_COMPONENT_TYPE_BYTE: {
-      const double v = load<std::int8_t>(bytes);
-      return normalized ? std::max(v / 127.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE: {
-      const double v = load<std::uint8_t>(bytes);
-      return normalized ? v / 255.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_SHORT: {
-      const double v = load<std::int16_t>(bytes);
-      return normalized ? std::max(v / 32767.0, -1.0) : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT: {
-      const double v = load<std::uint16_t>(bytes);
-      return normalized ? v / 65535.0 : v;
-    }
-    case TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT:
-      return load<std::uint32_t>(bytes);
-    default:
-      return load<float>(bytes);
-  }
-}
-
-struct Reader {
-  const tinygltf::Model& model;
-  const std::string& name;
-
-  /// Reads `count` elements of `components` components from a buffer view into `out`.
-  /// `strided`: honour the view's byteStride (vertex attributes), else tightly packed.
-  void read_view(const std::string& what, int view_index, std::size_t byte_offset,
-                 std::size_t count, int component_type, int components, bool normalized,
-                 bool strided, double* out) const {
-    if (view_index < 0 || static_cast<std::size_t>(view_index) >= model.bufferViews.size()) {
-      fail(name, what + ": bufferView " + std::to_string(view_index) + " does not exist");
-    }
-    const tinygltf::BufferView& view = model.bufferViews[static_cast<std::size_t>(view_index)];
-    if (view.buffer < 0 || static_cast<std::size_t>(view.buffer) >= model.buffers.size()) {
-      fail(name, what + ": buffer " + std::to_string(view.buffer) + " does not exist");
-    }
-    const std::vector<unsigned char>& data =
-        model.buffers[static_cast<std::size_t>(view.buffer)].data;
-    if (view.byteOffset > data.size() || view.byteLength > data.size() - view.byteOffset) {
-      fail(name, what + ": bufferView " + std::to_string(view_index) + " exceeds its buffer");
-    }
-    if (count == 0) return;
-    const std::size_t element_bytes =
-        static_cast<std::size_t>(component_size_bytes(component_type)) *
-        static_cast<std::size_t>(components);
-    const std::size_t stride = strided && view.byteStride != 0 ? view.byteStride : element_bytes;
-    if (stride < element_bytes) fail(name, what + ": byteStride smaller than one element");
-    // Last element must end inside the view: offset + stride * (count - 1) + element <= length.
-    if (byte_offset > view.byteLength || view.byteLength - byte_offset < element_bytes ||
-        count - 1 > (view.byteLength - byte_offset - element_bytes) / stride) {
-      fail(name,
-           what + ": accessor reads past the end of bufferView " + std::to_string(view_index));
-    }
-    const unsigned char* base = data.data() + view.byteOffset + byte_offset;
-    const std::size_t size = static_cast<std::size_t>(component_size_bytes(component_type));
-    for (std::size_t i = 0; i < count; ++i) {
-      for (int c = 0; c < components; ++c) {
-        out[i * static_cast<std::size_t>(components) + static_cast<std::size_t>(c)] =
-            read_component(base + i * stride + static_cast<std::size_t>(c) * size, component_type,
-                           normalized);
-      }
-    }
-  }
-
-  /// Reads a whole accessor (including sparse substitution) as doubles, `components` per
-  /// element; `components` receives the element width.
-  std::vector<double> read_accessor(const std::string& what, int accessor_index,
-                                    int& components) const {
-    if (accessor_index < 0 || static_cast<std::size_t>(accessor_index) >= model.accessors.size()) {
-      fail(name, what + ": accessor " + std::to_string(accessor_index) + " does not exist");
-    }
-    const tinygltf::Accessor& accessor = model.accessors[static_cast<std::size_t>(accessor_index)];
-    components = component_count(accessor.type);
-    if (components == 0 || component_size_bytes(accessor.componentType) == 0) {
-      fail(name, what + ": unsupported accessor type or component type");
-    }
-    const auto width = static_cast<std::size_t>(components);
-    if (accessor.bufferView < 0 && accessor.count > kMaxUnbackedElements) {
-      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
-    }
-    if (accessor.bufferView >= 0 && accessor.count > kMaxVertices) {
-      fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
-    }
-    std::vector<double> values;
-    if (accessor.bufferView >= 0) {
-      // Validate the view before allocating: it must hold count elements of >= 1 byte.
-      read_view(what, accessor.bufferView, accessor.byteOffset, 0, accessor.componentType,
-                components, accessor.normalized, true, nullptr);
-      const tinygltf::BufferView& view =
-          model.bufferViews[static_cast<std::size_t>(accessor.bufferView)];
-      if (accessor.count > view.byteLength) {
-        fail(name, what + ": accessor reads past the end of bufferView " +
-                       std::to_string(accessor.bufferView));
-      }
-      values.resize(accessor.count * width);
-      read_view(what, accessor.bufferView, accessor.byteOffset, accessor.count,
-                accessor.componentType, components, accessor.normalized, true, values.data());
-    } else {
-      values.assign(accessor.count * width, 0.0);
-    }
-    if (accessor.sparse.isSparse) {
-      const auto& sparse = accessor.sparse;
-      if (sparse.count < 0 || static_cast<std::size_t>(sparse.count) > accessor.count ||
-          sparse.indices.byteOffset < 0 || sparse.values.byteOffset < 0) {
-        fail(name, what + ": bad sparse accessor");
-      }
-      const int index_type = sparse.indices.componentType;
-      if (index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE &&
-          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT &&
-          index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT) {
-        fail(name, what + ": bad sparse index component type");
-      }
-      const auto sparse_count = static_cast<std::size_t>(sparse.count);
-      std::vector<double> targets(sparse_count);
-      std::vector<double> replacements(sparse_count * width);
-      read_view(what + " (sparse indices)", sparse.indices.bufferView,
-                static_cast<std::size_t>(sparse.indices.byteOffset), sparse_count, index_type, 1,
-                false, false, targets.data());
-      read_view(what + " (sparse values)", sparse.values.bufferView,
-                static_cast<std::size_t>(sparse.values.byteOffset), sparse_count,
-                accessor.componentType, components, accessor.normalized, false,
-                replacements.data());
-      for (std::size_t i = 0; i < sparse_count; ++i) {
-        const auto target = static_cast<std::size_t>(targets[i]);
-        if (target >= accessor.count) fail(name, what + ": sparse index out of range");
-        std::copy_n(replacements.begin() + static_cast<std::ptrdiff_t>(i * width), width,
-                    values.begin() + static_cast<std::ptrdiff_t>(target * width));
-      }
-    }
-    return values;
-  }
-};
-
 /// Node-local transform: the matrix when given (column-major, like GLM), else T * R * S.
 glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, int node_index) {
   const std::string what = "node " + std::to_string(node_index);
@@ -262,18 +83,7 @@ glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, 
   }
   glm::dmat4 r(1.0);
   if (!node.rotation.empty()) {
-    // Unit quaternion (x, y, z, w) -> rotation matrix; normalised first for robustness.
-    double x = node.rotation[0], y = node.rotation[1], z = node.rotation[2], w = node.rotation[3];
-    const double length = std::sqrt(x * x + y * y + z * z + w * w);
-    if (length > 0.0) {
-      x /= length;
-      y /= length;
-      z /= length;
-      w /= length;
-    }
-    r[0] = glm::dvec4(1 - 2 * (y * y + z * z), 2 * (x * y + z * w), 2 * (x * z - y * w), 0.0);
-    r[1] = glm::dvec4(2 * (x * y - z * w), 1 - 2 * (x * x + z * z), 2 * (y * z + x * w), 0.0);
-    r[2] = glm::dvec4(2 * (x * z + y * w), 2 * (y * z - x * w), 1 - 2 * (x * x + y * y), 0.0);
+    r = rotation_matrix(node.rotation[0], node.rotation[1], node.rotation[2], node.rotation[3]);
   }
   glm::dmat4 s(1.0);
   if (!node.scale.empty()) {
@@ -332,6 +142,22 @@ Material convert_material(const tinygltf::Material& source) {
   return m;
 }
 
+/// A glTF camera's projection (glTF 2.0, 3.10.2); aspectRatio is not kept: the image's
+/// width and height decide it.
+FileCamera file_camera(const tinygltf::Camera& camera) {
+  FileCamera out;
+  out.orthographic = camera.type == "orthographic";
+  if (out.orthographic) {
+    out.znear = camera.orthographic.znear;
+    out.zfar = camera.orthographic.zfar;
+  } else {
+    out.yfov_rad = camera.perspective.yfov;
+    out.znear = camera.perspective.znear;
+    out.zfar = camera.perspective.zfar;
+  }
+  return out;
+}
+
 /// Normals of one primitive in the node's world space: n_world = normalize(M^-T n) for the
 /// upper 3x3 M of the node's matrix (normals are covectors).
 std::vector<glm::vec3> world_normals(const std::vector<double>& values, const glm::dmat4& world) {
@@ -346,23 +172,11 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
   return normals;
 }
 
-/// The primitive's NORMAL attribute in world space, or empty when it has none.
-std::vector<glm::vec3> primitive_normals(const Reader& reader, const tinygltf::Primitive& primitive,
-                                         const std::string& what, const glm::dmat4& world,
-                                         std::size_t vertex_count) {
-  const auto it = primitive.attributes.find("NORMAL");
-  if (it == primitive.attributes.end()) return {};
-  int components = 0;
-  const std::vector<double> values = reader.read_accessor(what + " NORMAL", it->second, components);
-  if (components != 3) fail(reader.name, what + ": NORMAL must be VEC3");
-  if (values.size() / 3 != vertex_count)
-    fail(reader.name, what + ": NORMAL and POSITION counts differ");
-  return world_normals(values, world);
-}
-
 /// The file as tinygltf reads it (images accepted without decoding); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                            const std::filesystem::path& base_dir) {
+  const std::optional<std::string> rewritten = without_draco_indices(bytes);
+  if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&skip_image, nullptr);
@@ -378,6 +192,25 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                                        static_cast<unsigned>(bytes.size()), base_dir.string());
   if (!ok) throw InputError(loader_error_message(name, err));
   return model;
+}
+
+/// The glTF extensions covrast implements: a file may require these (extensionsRequired).
+/// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
+/// reader takes in every type anyway.
+constexpr std::array<std::string_view, 5> kImplementedExtensions = {
+    kDracoExtension, "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
+    "KHR_materials_unlit", "KHR_mesh_quantization"};
+
+/// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
+/// load, since drawing it without would be wrong.
+void check_required_extensions(const tinygltf::Model& model, const std::string& name) {
+  for (const std::string& extension : model.extensionsRequired) {
+    if (std::find(kImplementedExtensions.begin(), kImplementedExtensions.end(), extension) ==
+        kImplementedExtensions.end()) {
+      fail(name, "requires the glTF extension " + printable(extension) +
+                     ", which covrast does not implement");
+    }
+  }
 }
 
 /// Where the node walk starts: the chosen scene's nodes, or every node that is nobody's child
@@ -406,6 +239,19 @@ std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& nam
   return roots;
 }
 
+/// Where a primitive's attributes come from: its accessors, or its decoded Draco stream.
+struct PrimitiveSource {
+  const tinygltf::Primitive& primitive;
+  std::optional<DracoPrimitive> draco;
+};
+
+/// How one node's mesh reaches the file's world space, and its morph weights.
+struct Placement {
+  std::vector<glm::dmat4> worlds;       ///< one copy per matrix (instances); unskinned only
+  std::vector<glm::dmat4> skin_joints;  ///< skinned: the joint matrices, `worlds` unused
+  std::vector<double> morph_weights;    ///< the node's weights, else the mesh's
+};
+
 /// Collects the triangle primitives of the node tree into one MeshData: positions, indices,
 /// materials and normals as it goes, and the colours with what decides between vertex
 /// colours and one uniform colour (LoadedMesh::has_uniform_color) at the end.
@@ -421,44 +267,25 @@ class GltfMeshBuilder {
     }
     mesh_->materials.push_back(convert_material(tinygltf::Material{}));
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
+    for (const tinygltf::Camera& camera : model.cameras) cameras_.push_back(file_camera(camera));
   }
 
   /// Walks the node trees under `roots` depth first, in file order, composing the node
   /// transforms, and adds every mesh it meets once per node that uses it.
   void add_node_trees(const std::vector<int>& roots) {
-    struct Pending {
-      int node;
-      glm::dmat4 parent;
-    };
-    const std::size_t node_count = model_.nodes.size();
-    std::vector<Pending> stack;
-    for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
-      stack.push_back({*it, glm::dmat4(1.0)});
-    }
-    std::vector<bool> visited(node_count, false);
-    while (!stack.empty()) {
-      const Pending current = stack.back();
-      stack.pop_back();
-      if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
-        fail(name_, "node " + std::to_string(current.node) + " does not exist");
-      }
-      const auto node_index = static_cast<std::size_t>(current.node);
-      if (visited[node_index]) {
-        fail(name_, "node " + std::to_string(current.node) +
-                        " is reached twice (the node hierarchy must be a tree)");
-      }
-      visited[node_index] = true;
-      const tinygltf::Node& node = model_.nodes[node_index];
-      const glm::dmat4 world = current.parent * local_transform(node, name_, current.node);
-      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
-        stack.push_back({*it, world});
-      }
-      if (node.mesh >= 0) add_mesh(current.node, node.mesh, world);
+    for (const int node_index : walk_nodes(roots)) {
+      const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
+      if (node.mesh >= 0) add_mesh(node_index, node.mesh, node_placement(node_index));
+      if (node.camera >= 0) place_camera(node_index, node.camera);
     }
   }
 
   LoadedMesh finish() {
     LoadedMesh loaded;
+    loaded.cameras = std::move(cameras_);
+    if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
+      loaded.warnings.push_back(undrawn);
+    }
     if (emissive_textures_ > 0) {
       loaded.lit_warnings.push_back(name_ + ": " + std::to_string(emissive_textures_) +
                                     " materials with an emissive texture: textures are not "
@@ -478,56 +305,136 @@ class GltfMeshBuilder {
   }
 
  private:
-  /// Mesh `mesh_index` of node `node_index`, with the node's world transform.
-  void add_mesh(int node_index, int mesh_index, const glm::dmat4& world) {
+  /// Mesh `mesh_index` of node `node_index`, placed by `placement` with the node's morph
+  /// weights. Primitives of the point and line modes are counted (LoadedMesh::warnings), not
+  /// drawn.
+  void add_mesh(int node_index, int mesh_index, Placement placement) {
     if (static_cast<std::size_t>(mesh_index) >= model_.meshes.size()) {
       fail(name_, "node " + std::to_string(node_index) + ": mesh " + std::to_string(mesh_index) +
                       " does not exist");
     }
     const tinygltf::Mesh& gltf_mesh = model_.meshes[static_cast<std::size_t>(mesh_index)];
+    // glTF 2.0, 3.7.2.2: the node's weights override the mesh's default weights.
+    const std::vector<double>& node_weights =
+        model_.nodes[static_cast<std::size_t>(node_index)].weights;
+    placement.morph_weights = node_weights.empty() ? gltf_mesh.weights : node_weights;
     for (std::size_t p = 0; p < gltf_mesh.primitives.size(); ++p) {
       const tinygltf::Primitive& primitive = gltf_mesh.primitives[p];
+      const std::string what =
+          "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p);
       const int mode = primitive.mode < 0 ? TINYGLTF_MODE_TRIANGLES : primitive.mode;
-      if (mode != TINYGLTF_MODE_TRIANGLES) continue;  // points, lines, strips, fans: not drawn
-      add_primitive(primitive,
-                    "mesh " + std::to_string(mesh_index) + " primitive " + std::to_string(p),
-                    world);
+      if (mode > TINYGLTF_MODE_TRIANGLE_FAN) {
+        fail(name_, what + ": unknown mode " + std::to_string(mode) + " (glTF has 0..6)");
+      }
+      if (mode < TINYGLTF_MODE_TRIANGLES) {
+        ++undrawn_primitives_[static_cast<std::size_t>(mode)];
+        continue;
+      }
+      add_primitive(primitive, mode, what, placement);
     }
   }
 
-  /// One mode-TRIANGLES primitive; `what` names it in messages.
-  void add_primitive(const tinygltf::Primitive& primitive, const std::string& what,
-                     const glm::dmat4& world) {
-    const auto position_it = primitive.attributes.find("POSITION");
-    if (position_it == primitive.attributes.end()) fail(name_, what + ": no POSITION attribute");
-    int components = 0;
-    const std::vector<double> positions =
-        reader_.read_accessor(what + " POSITION", position_it->second, components);
-    if (components != 3) fail(name_, what + ": POSITION must be VEC3");
-    const std::size_t vertex_count = positions.size() / 3;
-    const std::size_t base = mesh_->positions.size();
-    if (vertex_count > kMaxVertices - base) fail(name_, "too many vertices");
-
-    const glm::dvec3 factor = base_color_factor(primitive, what);
-    const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
-                                   clamp_unit(factor.b));
-    if (!any_primitive_) {
-      first_factor_ = factor_clamped;
-    } else if (factor_clamped != first_factor_) {
-      factors_differ_ = true;
+  /// One primitive of a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN); `what`
+  /// names it in messages.
+  void add_primitive(const tinygltf::Primitive& primitive, int mode, const std::string& what,
+                     const Placement& placement) {
+    const PrimitiveSource source{primitive, decode_draco_primitive(primitive, what)};
+    if (source.draco) mode = TINYGLTF_MODE_TRIANGLES;  // the decoded faces are a triangle list
+    PrimitiveVertices vertices = read_vertices(source, what);
+    add_morph_targets(reader_, primitive, placement.morph_weights, what, vertices);
+    const std::size_t vertex_count = vertices.count();
+    if (vertex_count > kMaxVertices - mesh_->positions.size()) fail(name_, "too many vertices");
+    const std::vector<std::uint32_t> corners = triangle_corners(
+        mode, vertex_sequence(source, what, vertex_count), primitive.indices >= 0, what);
+    const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count);
+    const std::uint32_t material = primitive.material >= 0
+                                       ? static_cast<std::uint32_t>(primitive.material)
+                                       : default_material_;
+    if (placement.skin_joints.empty()) {
+      for (const glm::dmat4& world : placement.worlds) {
+        place(vertices, corners, colors, material, world);
+      }
+    } else {
+      const std::vector<glm::dmat4> skin =
+          vertex_skin_matrices(skin_influences(source, vertices.count(), what), vertices.count(),
+                               placement.skin_joints, name_, what);
+      place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0));
     }
-    any_primitive_ = true;
+  }
 
-    for (std::size_t v = 0; v < vertex_count; ++v) {
+  /// Camera `camera_index` at node `node_index`, unless an earlier node placed it.
+  void place_camera(int node_index, int camera_index) {
+    if (static_cast<std::size_t>(camera_index) >= cameras_.size()) {
+      fail(name_, "node " + std::to_string(node_index) + ": camera " +
+                      std::to_string(camera_index) + " does not exist");
+    }
+    FileCamera& camera = cameras_[static_cast<std::size_t>(camera_index)];
+    if (camera.placed) return;
+    camera.placed = true;
+    camera.world = node_world_[static_cast<std::size_t>(node_index)];
+  }
+
+  /// How node `node_index`'s mesh is placed: skinned by its skin's joints (the node's own
+  /// transform then does not apply, glTF 2.0, 3.7.3.3), or once per EXT_mesh_gpu_instancing
+  /// instance, or once at the node.
+  Placement node_placement(int node_index) const {
+    const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
+    Placement placement;
+    if (node.skin >= 0) {
+      placement.skin_joints = joint_matrices(reader_, node.skin, node_index, node_world_, reached_);
+      return placement;
+    }
+    const glm::dmat4& world = node_world_[static_cast<std::size_t>(node_index)];
+    const auto instancing = node.extensions.find(std::string(kInstancingExtension));
+    if (instancing == node.extensions.end()) {
+      placement.worlds.push_back(world);
+      return placement;
+    }
+    for (const glm::dmat4& instance :
+         instance_transforms(reader_, instancing->second, node_index)) {
+      placement.worlds.push_back(world * instance);
+    }
+    return placement;
+  }
+
+  /// The primitive's JOINTS_0 / WEIGHTS_0, JOINTS_1 / WEIGHTS_1, ... sets (glTF 2.0, 3.7.3.3).
+  std::vector<SkinInfluences> skin_influences(const PrimitiveSource& source,
+                                              std::size_t vertex_count,
+                                              const std::string& what) const {
+    std::vector<SkinInfluences> sets;
+    for (int set = 0;; ++set) {
+      // Appended piecewise: "_" + std::to_string(set) trips a g++ 12 -Wrestrict false positive.
+      std::string suffix = "_";
+      suffix += std::to_string(set);
+      int joint_components = 0, weight_components = 0;
+      auto joints = attribute_values(source, "JOINTS" + suffix, what, joint_components);
+      auto weights = attribute_values(source, "WEIGHTS" + suffix, what, weight_components);
+      if (!joints && !weights) return sets;
+      if (!joints || !weights || joint_components != 4 || weight_components != 4 ||
+          joints->size() != 4 * vertex_count || weights->size() != 4 * vertex_count) {
+        fail(name_, what + ": JOINTS" + suffix + " and WEIGHTS" + suffix +
+                        " must both be VEC4 with one value per vertex");
+      }
+      sets.push_back({std::move(*joints), std::move(*weights)});
+    }
+  }
+
+  /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
+  /// triangles (turned when `world` mirrors), their material and their normals.
+  void place(const PrimitiveVertices& vertices, const std::vector<std::uint32_t>& corners,
+             const std::vector<glm::vec3>& colors, std::uint32_t material,
+             const glm::dmat4& world) {
+    const std::size_t base = mesh_->positions.size();
+    const std::vector<double>& positions = vertices.positions;
+    for (std::size_t v = 0; v < vertices.count(); ++v) {
       const glm::dvec4 p_world =
           world * glm::dvec4(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2], 1.0);
       mesh_->positions.emplace_back(static_cast<float>(p_world.x), static_cast<float>(p_world.y),
                                     static_cast<float>(p_world.z));
     }
-    add_colors(primitive, what, vertex_count, factor, factor_clamped);
-
+    colors_.insert(colors_.end(), colors.begin(), colors.end());
     const std::size_t first_index = mesh_->indices.size();
-    add_indices(primitive, what, vertex_count, base);
+    add_triangles(corners, base);
     // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
     // clockwise; swapping two corners keeps counter-clockwise = front after baking.
     if (glm::determinant(glm::dmat3(world)) < 0.0) {
@@ -535,12 +442,80 @@ class GltfMeshBuilder {
         std::swap(mesh_->indices[i + 1], mesh_->indices[i + 2]);
       }
     }
-    const std::uint32_t material = primitive.material >= 0
-                                       ? static_cast<std::uint32_t>(primitive.material)
-                                       : default_material_;
     mesh_->triangle_materials.resize(mesh_->indices.size() / 3, material);
-    add_corner_normals(primitive_normals(reader_, primitive, what, world, vertex_count), base,
-                       first_index);
+    add_corner_normals(vertices.normals.empty() ? std::vector<glm::vec3>{}
+                                                : world_normals(vertices.normals, world),
+                       base, first_index);
+  }
+
+  /// The primitive's Draco stream decoded, when it has the extension (gltf_draco.hpp).
+  std::optional<DracoPrimitive> decode_draco_primitive(const tinygltf::Primitive& primitive,
+                                                       const std::string& what) const {
+    const auto it = primitive.extensions.find(std::string(kDracoExtension));
+    if (it == primitive.extensions.end()) return std::nullopt;
+    const tinygltf::Value& extension = it->second;
+    const std::string where = what + ": " + std::string(kDracoExtension);
+    if (!extension.IsObject() || !extension.Has("bufferView") ||
+        !extension.Get("bufferView").IsInt() || !extension.Get("attributes").IsObject()) {
+      fail(name_, where + ": needs a bufferView and an attributes object");
+    }
+    const int view_index = extension.Get("bufferView").GetNumberAsInt();
+    const unsigned char* bytes = reader_.view_bytes(where, view_index);
+    const std::size_t size = model_.bufferViews[static_cast<std::size_t>(view_index)].byteLength;
+    std::map<std::string, DracoAttributeRef> refs;
+    const tinygltf::Value& attributes = extension.Get("attributes");
+    for (const std::string& key : attributes.Keys()) {
+      const tinygltf::Value& id = attributes.Get(key);
+      if (!id.IsInt() || id.GetNumberAsInt() < 0) {
+        fail(name_, where + ": attribute " + printable(key) + " needs a Draco id");
+      }
+      const auto accessor = primitive.attributes.find(key);
+      const bool normalized =
+          accessor != primitive.attributes.end() && accessor->second >= 0 &&
+          static_cast<std::size_t>(accessor->second) < model_.accessors.size() &&
+          model_.accessors[static_cast<std::size_t>(accessor->second)].normalized;
+      refs[key] = {static_cast<std::uint32_t>(id.GetNumberAsInt()), normalized};
+    }
+    return decode_draco(bytes, size, refs, name_, what);
+  }
+
+  /// Attribute `attribute` of the primitive (its Draco values first, else its accessor), or
+  /// nullopt when it has none; `components` receives the element width.
+  std::optional<std::vector<double>> attribute_values(const PrimitiveSource& source,
+                                                      const std::string& attribute,
+                                                      const std::string& what,
+                                                      int& components) const {
+    if (source.draco) {
+      const auto it = source.draco->attributes.find(attribute);
+      if (it != source.draco->attributes.end()) {
+        components = it->second.components;
+        return it->second.values;
+      }
+    }
+    const auto it = source.primitive.attributes.find(attribute);
+    if (it == source.primitive.attributes.end()) return std::nullopt;
+    return reader_.read_accessor(what + " " + attribute, it->second, components);
+  }
+
+  /// POSITION and NORMAL (when present) as the file gives them.
+  PrimitiveVertices read_vertices(const PrimitiveSource& source, const std::string& what) const {
+    PrimitiveVertices vertices;
+    int components = 0;
+    std::optional<std::vector<double>> positions =
+        attribute_values(source, "POSITION", what, components);
+    if (!positions) fail(name_, what + ": no POSITION attribute");
+    if (components != 3) fail(name_, what + ": POSITION must be VEC3");
+    vertices.positions = std::move(*positions);
+    std::optional<std::vector<double>> normals =
+        attribute_values(source, "NORMAL", what, components);
+    if (normals) {
+      if (components != 3) fail(name_, what + ": NORMAL must be VEC3");
+      if (normals->size() != vertices.positions.size()) {
+        fail(name_, what + ": NORMAL and POSITION counts differ");
+      }
+      vertices.normals = std::move(*normals);
+    }
+    return vertices;
   }
 
   /// The primitive's material's baseColorFactor (RGB), or 1 without a material.
@@ -558,45 +533,58 @@ class GltfMeshBuilder {
     return factor;
   }
 
-  /// The primitive's vertex colours: COLOR_0 x factor, or the (clamped) factor alone.
-  void add_colors(const tinygltf::Primitive& primitive, const std::string& what,
-                  std::size_t vertex_count, glm::dvec3 factor, glm::vec3 factor_clamped) {
-    const auto color_it = primitive.attributes.find("COLOR_0");
-    if (color_it == primitive.attributes.end()) {
-      colors_.insert(colors_.end(), vertex_count, factor_clamped);
-      return;
+  /// The primitive's vertex colours: COLOR_0 x baseColorFactor, or the (clamped) factor
+  /// alone. Notes what decides the mesh's colour selection (finish()).
+  std::vector<glm::vec3> vertex_colors(const PrimitiveSource& source, const std::string& what,
+                                       std::size_t vertex_count) {
+    const glm::dvec3 factor = base_color_factor(source.primitive, what);
+    const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
+                                   clamp_unit(factor.b));
+    if (!any_primitive_) {
+      first_factor_ = factor_clamped;
+    } else if (factor_clamped != first_factor_) {
+      factors_differ_ = true;
     }
+    any_primitive_ = true;
+    int components = 0;
+    const std::optional<std::vector<double>> values =
+        attribute_values(source, "COLOR_0", what, components);
+    if (!values) return std::vector<glm::vec3>(vertex_count, factor_clamped);
     any_color_attribute_ = true;
-    int color_components = 0;
-    const std::vector<double> color_values =
-        reader_.read_accessor(what + " COLOR_0", color_it->second, color_components);
-    if (color_components != 3 && color_components != 4) {
-      fail(name_, what + ": COLOR_0 must be VEC3 or VEC4");
-    }
-    const auto width = static_cast<std::size_t>(color_components);
-    if (color_values.size() / width != vertex_count) {
+    if (components != 3 && components != 4) fail(name_, what + ": COLOR_0 must be VEC3 or VEC4");
+    const auto width = static_cast<std::size_t>(components);
+    if (values->size() / width != vertex_count) {
       fail(name_, what + ": COLOR_0 and POSITION counts differ");
     }
+    std::vector<glm::vec3> colors;
+    colors.reserve(vertex_count);
     for (std::size_t v = 0; v < vertex_count; ++v) {
-      colors_.emplace_back(clamp_unit(color_values[width * v] * factor.r),
-                           clamp_unit(color_values[width * v + 1] * factor.g),
-                           clamp_unit(color_values[width * v + 2] * factor.b));
+      colors.emplace_back(clamp_unit((*values)[width * v] * factor.r),
+                          clamp_unit((*values)[width * v + 1] * factor.g),
+                          clamp_unit((*values)[width * v + 2] * factor.b));
     }
+    return colors;
   }
 
-  /// The primitive's triangles as mesh indices (its vertices start at `base`): its index
-  /// accessor, or consecutive vertices when it has none.
-  void add_indices(const tinygltf::Primitive& primitive, const std::string& what,
-                   std::size_t vertex_count, std::size_t base) {
+  /// The primitive's vertex sequence: its index accessor, its Draco faces, or 0, 1, ... when
+  /// it has neither.
+  std::vector<std::uint32_t> vertex_sequence(const PrimitiveSource& source, const std::string& what,
+                                             std::size_t vertex_count) const {
+    const tinygltf::Primitive& primitive = source.primitive;
+    if (source.draco) {
+      for (const std::uint32_t corner : source.draco->corners) {
+        if (corner >= vertex_count) {
+          fail(name_, what + ": Draco corner " + std::to_string(corner) + " out of range (" +
+                          std::to_string(vertex_count) + " vertices)");
+        }
+      }
+      return source.draco->corners;
+    }
+    std::vector<std::uint32_t> sequence;
     if (primitive.indices < 0) {
-      if (vertex_count % 3 != 0) {
-        fail(name_,
-             what + ": vertex count " + std::to_string(vertex_count) + " is not a multiple of 3");
-      }
-      for (std::size_t v = 0; v < vertex_count; ++v) {
-        mesh_->indices.push_back(static_cast<std::uint32_t>(base + v));
-      }
-      return;
+      sequence.resize(vertex_count);
+      for (std::size_t v = 0; v < vertex_count; ++v) sequence[v] = static_cast<std::uint32_t>(v);
+      return sequence;
     }
     int index_components = 0;
     const std::vector<double> indices =
@@ -608,16 +596,60 @@ class GltfMeshBuilder {
                                   index_type != TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT)) {
       fail(name_, what + ": indices must be unsigned byte, short or int scalars");
     }
-    if (indices.size() % 3 != 0) {
-      fail(name_,
-           what + ": index count " + std::to_string(indices.size()) + " is not a multiple of 3");
-    }
     for (const double index : indices) {
       if (index >= static_cast<double>(vertex_count)) {
         fail(name_, what + ": index " + std::to_string(static_cast<std::uint64_t>(index)) +
                         " out of range (" + std::to_string(vertex_count) + " vertices)");
       }
-      mesh_->indices.push_back(static_cast<std::uint32_t>(base + static_cast<std::size_t>(index)));
+      sequence.push_back(static_cast<std::uint32_t>(index));
+    }
+    return sequence;
+  }
+
+  /// The corners of the triangles that `mode` makes of `sequence`, 3 per triangle (glTF 2.0
+  /// spec, 3.7.2.1): TRIANGLES takes them three by three; TRIANGLE_STRIP makes triangle i
+  /// (v_i, v_{i+1+i%2}, v_{i+2-i%2}), so every other one is turned to keep the winding;
+  /// TRIANGLE_FAN makes (v_{i+1}, v_{i+2}, v_0).
+  ///
+  ///   strip  1---3---5        fan   2---1
+  ///         / \ / \ /              |  /|
+  ///        0---2---4                | / |
+  ///                                 |/  |
+  ///                                 0---4 ... around v_0
+  /// `indexed`: the sequence comes from an index accessor (for messages).
+  std::vector<std::uint32_t> triangle_corners(int mode, std::vector<std::uint32_t> sequence,
+                                              bool indexed, const std::string& what) const {
+    const std::size_t n = sequence.size();
+    if (mode == TINYGLTF_MODE_TRIANGLES) {
+      if (n % 3 != 0) {
+        fail(name_, what + (indexed ? ": index count " : ": vertex count ") + std::to_string(n) +
+                        " is not a multiple of 3");
+      }
+      return sequence;
+    }
+    const char* const mode_name =
+        mode == TINYGLTF_MODE_TRIANGLE_STRIP ? "TRIANGLE_STRIP" : "TRIANGLE_FAN";
+    if (n < 3) {
+      fail(name_, what + ": " + mode_name + " needs at least 3 vertices, got " + std::to_string(n));
+    }
+    std::vector<std::uint32_t> corners;
+    corners.reserve(3 * (n - 2));
+    for (std::size_t i = 0; i + 2 < n; ++i) {
+      if (mode == TINYGLTF_MODE_TRIANGLE_STRIP) {
+        corners.insert(corners.end(),
+                       {sequence[i], sequence[i + 1 + i % 2], sequence[i + 2 - i % 2]});
+      } else {
+        corners.insert(corners.end(), {sequence[i + 1], sequence[i + 2], sequence[0]});
+      }
+    }
+    return corners;
+  }
+
+  /// Appends triangle corners (primitive vertex numbers) as mesh indices; the primitive's
+  /// vertices start at `base`.
+  void add_triangles(const std::vector<std::uint32_t>& corners, std::size_t base) {
+    for (const std::uint32_t corner : corners) {
+      mesh_->indices.push_back(static_cast<std::uint32_t>(base + corner));
     }
   }
 
@@ -637,13 +669,73 @@ class GltfMeshBuilder {
     }
   }
 
+  /// "name: 3 primitives not drawn (POINTS 1, LINES 2): covrast draws triangles only", or
+  /// empty when every primitive was a triangle one.
+  std::string undrawn_primitives_message() const {
+    static const char* const kModeNames[] = {"POINTS", "LINES", "LINE_LOOP", "LINE_STRIP"};
+    std::size_t total = 0;
+    std::string counts;
+    for (std::size_t mode = 0; mode < undrawn_primitives_.size(); ++mode) {
+      if (undrawn_primitives_[mode] == 0) continue;
+      total += undrawn_primitives_[mode];
+      counts += (counts.empty() ? "" : ", ") + std::string(kModeNames[mode]) + " " +
+                std::to_string(undrawn_primitives_[mode]);
+    }
+    if (total == 0) return {};
+    return name_ + ": " + std::to_string(total) + " primitives not drawn (" + counts +
+           "): covrast draws triangles only";
+  }
+
+  /// The nodes of the trees under `roots` in depth-first file order; sets node_world_ (the
+  /// composed transforms) and reached_ for each.
+  std::vector<int> walk_nodes(const std::vector<int>& roots) {
+    struct Pending {
+      int node;
+      glm::dmat4 parent;
+    };
+    const std::size_t node_count = model_.nodes.size();
+    node_world_.assign(node_count, glm::dmat4(1.0));
+    reached_.assign(node_count, false);
+    std::vector<Pending> stack;
+    for (auto it = roots.rbegin(); it != roots.rend(); ++it) {
+      stack.push_back({*it, glm::dmat4(1.0)});
+    }
+    std::vector<int> order;
+    while (!stack.empty()) {
+      const Pending current = stack.back();
+      stack.pop_back();
+      if (current.node < 0 || static_cast<std::size_t>(current.node) >= node_count) {
+        fail(name_, "node " + std::to_string(current.node) + " does not exist");
+      }
+      const auto node_index = static_cast<std::size_t>(current.node);
+      if (reached_[node_index]) {
+        fail(name_, "node " + std::to_string(current.node) +
+                        " is reached twice (the node hierarchy must be a tree)");
+      }
+      reached_[node_index] = true;
+      const tinygltf::Node& node = model_.nodes[node_index];
+      node_world_[node_index] = current.parent * local_transform(node, name_, current.node);
+      for (auto it = node.children.rbegin(); it != node.children.rend(); ++it) {
+        stack.push_back({*it, node_world_[node_index]});
+      }
+      order.push_back(current.node);
+    }
+    return order;
+  }
+
   const tinygltf::Model& model_;
   const std::string& name_;
-  const Reader reader_;
+  const GltfReader reader_;
   std::shared_ptr<MeshData> mesh_;
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
+  std::vector<FileCamera> cameras_;
+  std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
+  std::vector<bool> reached_;           ///< per node: in the walked scene
+  /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per
+  /// node that uses them.
+  std::array<std::size_t, 4> undrawn_primitives_{};
   std::vector<glm::vec3> colors_;  ///< per vertex: COLOR_0 x factor, or the factor alone
   bool any_color_attribute_ = false;
   bool any_primitive_ = false;
@@ -656,6 +748,7 @@ class GltfMeshBuilder {
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                       const std::filesystem::path& base_dir) {
   const tinygltf::Model model = read_model(bytes, display_name, base_dir);
+  check_required_extensions(model, display_name);
   const std::vector<int> roots = root_nodes(model, display_name);
   GltfMeshBuilder builder(model, display_name);
   builder.add_node_trees(roots);

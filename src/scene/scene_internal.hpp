@@ -14,6 +14,18 @@
 
 namespace covrast::detail {
 
+/// A camera of a glTF file (glTF 2.0, 3.10), where the scene's {"gltf": N} camera comes from.
+struct FileCamera {
+  bool orthographic = false;  ///< covrast renders perspective only
+  double yfov_rad = 0.0;      ///< vertical field of view [radians]
+  double znear = 0.0;         ///< [file units]
+  double zfar = 0.0;          ///< [file units]; 0: infinite
+  /// Placed by a node of the walked scene (the first one in the walk that names it); its
+  /// world transform then is `world` (the camera looks down its -z, +y up).
+  bool placed = false;
+  glm::dmat4 world{1.0};
+};
+
 /// A parsed mesh file plus what MeshData cannot carry.
 struct LoadedMesh {
   std::shared_ptr<MeshData> data;
@@ -27,6 +39,8 @@ struct LoadedMesh {
   std::vector<std::string> warnings;
   /// The same, for what matters only when the scene is lit (materials).
   std::vector<std::string> lit_warnings;
+  /// glTF: the file's cameras, in file order.
+  std::vector<FileCamera> cameras;
 };
 
 /// Reads a whole file. On failure returns false and sets `error` to the system's reason

@@ -5,9 +5,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <memory>
+#include <numbers>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -542,10 +545,18 @@ void select_color(const SceneReader& reader, const std::string& file, const json
   }
 }
 
+/// The scene's first glTF mesh entry: where a {"gltf": N} camera comes from.
+struct FirstGltf {
+  const detail::LoadedMesh* loaded = nullptr;  ///< null: no glTF mesh (yet)
+  std::string relative;                        ///< the file as the scene names it
+  glm::dmat4 model{1.0};                       ///< the entry's model matrix
+};
+
 /// Entry `key` of "meshes": its mesh (loaded through `cache`), colour, model matrix,
-/// materials and normals.
+/// materials and normals. The first glTF entry is noted in `first_gltf`.
 MeshInstance load_instance(const SceneReader& reader, const std::string& file, const json& value,
-                           const std::string& key, SceneMeshes& cache, Scene& scene) {
+                           const std::string& key, SceneMeshes& cache, Scene& scene,
+                           FirstGltf& first_gltf) {
   const json& entry = reader.require_object(value, key);
   const MeshFileRef ref = mesh_file_ref(file, entry, key);
   CachedMesh& cached = cache.get(ref, key, scene);
@@ -561,7 +572,69 @@ MeshInstance load_instance(const SceneReader& reader, const std::string& file, c
   }
   instance.materials = instance_materials(reader, entry, key, *loaded.data);
   select_normals(reader, file, entry, key, ref.relative, cached, instance);
+  if (ref.format == MeshFormat::Gltf && first_gltf.loaded == nullptr) {
+    first_gltf = {&loaded, ref.relative, instance.model};
+  }
   return instance;
+}
+
+/// A far plane for a camera without one (glTF's infinite projection): beyond every mesh of
+/// the scene, twice the distance from `eye` to the farthest corner of their world boxes.
+double far_beyond_meshes(const Scene& scene, const glm::dvec3& eye, double near) {
+  double farthest = 0.0;
+  for (const MeshInstance& instance : scene.meshes) {
+    const glm::dvec3 lo(instance.mesh->bounds_min), hi(instance.mesh->bounds_max);
+    for (int corner = 0; corner < 8; ++corner) {
+      const glm::dvec4 p(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y,
+                         corner & 4 ? hi.z : lo.z, 1.0);
+      farthest = std::max(farthest, glm::length(glm::dvec3(instance.model * p) - eye));
+    }
+  }
+  return std::max(2.0 * farthest, 2.0 * near);
+}
+
+/// "camera": {"gltf": N}: camera N of the scene's first glTF mesh entry, placed at its node's
+/// world transform times that entry's model matrix; it looks down its -z with +y up (glTF
+/// 2.0, 3.10.1). Only perspective cameras; aspectRatio gives way to the image's size.
+Camera gltf_camera(const std::string& file, const json& object, const FirstGltf& first,
+                   const Scene& scene) {
+  if (object.size() != 1) fail(file, "camera", "with \"gltf\" give no other camera key");
+  const json& index_value = object["gltf"];
+  if (!index_value.is_number_unsigned()) {
+    fail(file, "camera.gltf", "expected a camera index >= 0, got " + shown(index_value));
+  }
+  if (first.loaded == nullptr) fail(file, "camera.gltf", "the scene has no glTF mesh");
+  const auto index = index_value.get<std::uint64_t>();
+  const std::string which = "camera " + std::to_string(index) + " of '" + first.relative + "'";
+  const std::vector<detail::FileCamera>& cameras = first.loaded->cameras;
+  if (index >= cameras.size()) {
+    fail(file, "camera.gltf",
+         which + " does not exist (" + std::to_string(cameras.size()) + " cameras)");
+  }
+  const detail::FileCamera& source = cameras[static_cast<std::size_t>(index)];
+  if (source.orthographic) {
+    fail(file, "camera.gltf", which + " is orthographic: covrast renders perspective only");
+  }
+  if (!source.placed) fail(file, "camera.gltf", which + " is on no node of the file's scene");
+  if (!(source.yfov_rad > 0.0 && source.yfov_rad < std::numbers::pi) || !(source.znear > 0.0) ||
+      !(source.zfar == 0.0 || source.zfar > source.znear)) {
+    fail(file, "camera.gltf", which + " needs 0 < yfov < pi, znear > 0 and zfar > znear");
+  }
+  const glm::dmat4 world = first.model * source.world;
+  Camera camera;
+  camera.eye = glm::dvec3(world[3]);
+  const glm::dvec3 forward = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+  camera.up = glm::dmat3(world) * glm::dvec3(0.0, 1.0, 0.0);
+  const double length = glm::length(forward);
+  if (!(length > 0.0) || !std::isfinite(length) ||
+      !(glm::length(glm::cross(forward, camera.up)) > 1e-6 * length * glm::length(camera.up))) {
+    fail(file, "camera.gltf", which + ": its node's transform is degenerate");
+  }
+  camera.target = camera.eye + forward / length;
+  camera.fovy_deg = glm::degrees(source.yfov_rad);
+  camera.near = source.znear;
+  camera.far = source.zfar > 0.0 ? source.zfar : far_beyond_meshes(scene, camera.eye, camera.near);
+  return camera;
 }
 
 /// The scene file's top-level JSON object.
@@ -603,7 +676,9 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
   if (const auto it = root.find("background"); it != root.end()) {
     scene.background_linear = reader.srgb_color(*it, "background");
   }
-  scene.camera = reader.camera(root);
+  const json& camera = reader.required(root, "camera", "camera");
+  const bool camera_from_gltf = camera.is_object() && camera.contains("gltf");
+  if (!camera_from_gltf) scene.camera = reader.camera(root);
   if (const auto it = root.find("lights"); it != root.end()) {
     scene.lit = true;
     scene.lights = reader.lights(*it);
@@ -612,10 +687,12 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
   SceneMeshes cache(file, json_path.parent_path(), mesh_files.impl_->files);
+  FirstGltf first_gltf;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string key = "meshes[" + std::to_string(i) + "]";
-    scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene));
+    scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene, first_gltf));
   }
+  if (camera_from_gltf) scene.camera = gltf_camera(file, camera, first_gltf, scene);
   return scene;
 }
 

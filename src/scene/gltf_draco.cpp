@@ -1,0 +1,169 @@
+// KHR_draco_mesh_compression (github.com/KhronosGroup/glTF, extensions/2.0/Khronos/
+// KHR_draco_mesh_compression): the primitive's attributes and indices are one Draco stream in
+// a bufferView; each glTF attribute names a Draco attribute by unique id. Decoded with Debian's
+// libdraco; the values then go the same way as an accessor's (mesh_gltf.cpp).
+#include "scene/gltf_draco.hpp"
+
+#include <covrast/error.hpp>
+
+#include <draco/compression/decode.h>
+#include <draco/core/decoder_buffer.h>
+#include <nlohmann/json.hpp>
+
+#include <cstring>
+#include <memory>
+
+namespace covrast::detail {
+namespace {
+
+using nlohmann::json;
+
+constexpr std::uint32_t kGlbJsonChunk = 0x4E4F534Au;  // "JSON"
+constexpr std::size_t kGlbHeaderBytes = 12;           // magic, version, length
+constexpr std::size_t kGlbChunkHeaderBytes = 8;       // length, type
+
+std::uint32_t load_u32(const char* bytes) {
+  std::uint32_t value;
+  std::memcpy(&value, bytes, 4);
+  return value;
+}
+
+void append_u32(std::string& out, std::uint32_t value) {
+  char bytes[4];
+  std::memcpy(bytes, &value, 4);
+  out.append(bytes, 4);
+}
+
+/// Removes "indices" from every primitive with the Draco extension; false when none had it.
+bool strip_indices(json& document) {
+  bool changed = false;
+  const auto meshes = document.find("meshes");
+  if (meshes == document.end() || !meshes->is_array()) return false;
+  for (json& mesh : *meshes) {
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) {
+      continue;
+    }
+    for (json& primitive : mesh["primitives"]) {
+      if (!primitive.is_object()) continue;
+      const auto extensions = primitive.find("extensions");
+      if (extensions == primitive.end() || !extensions->is_object() ||
+          !extensions->contains(kDracoExtension)) {
+        continue;
+      }
+      changed = primitive.erase("indices") > 0 || changed;
+    }
+  }
+  return changed;
+}
+
+/// The JSON text with Draco indices removed, or nullopt (no change, or no valid JSON).
+std::optional<std::string> rewrite_json(std::string_view text) {
+  json document = json::parse(text, nullptr, false);
+  if (document.is_discarded() || !document.is_object() || !strip_indices(document)) {
+    return std::nullopt;
+  }
+  return document.dump();
+}
+
+/// A .glb with its JSON chunk rewritten; the chunks after it are kept byte for byte.
+std::optional<std::string> rewrite_glb(std::string_view bytes) {
+  if (bytes.size() < kGlbHeaderBytes + kGlbChunkHeaderBytes) return std::nullopt;
+  const std::uint32_t json_length = load_u32(bytes.data() + kGlbHeaderBytes);
+  const std::uint32_t chunk_type = load_u32(bytes.data() + kGlbHeaderBytes + 4);
+  const std::size_t json_begin = kGlbHeaderBytes + kGlbChunkHeaderBytes;
+  if (chunk_type != kGlbJsonChunk || json_length > bytes.size() - json_begin) return std::nullopt;
+  std::optional<std::string> text = rewrite_json(bytes.substr(json_begin, json_length));
+  if (!text) return std::nullopt;
+  while (text->size() % 4 != 0) *text += ' ';  // chunks stay 4-byte aligned
+  const std::string_view rest = bytes.substr(json_begin + json_length);
+  std::string out(bytes.substr(0, 8));  // magic and version
+  append_u32(out, static_cast<std::uint32_t>(json_begin + text->size() + rest.size()));
+  append_u32(out, static_cast<std::uint32_t>(text->size()));
+  append_u32(out, kGlbJsonChunk);
+  out += *text;
+  out += rest;
+  return out;
+}
+
+[[noreturn]] void fail(const std::string& name, const std::string& what,
+                       const std::string& message) {
+  throw InputError(name + ": " + what + ": " + std::string(kDracoExtension) + ": " + message);
+}
+
+/// Largest value of an unsigned or signed integer Draco type, for normalized attributes
+/// whose stream does not say so itself; 0 for float types.
+double integer_range(draco::DataType type) {
+  switch (type) {
+    case draco::DT_UINT8:
+      return 255.0;
+    case draco::DT_INT8:
+      return 127.0;
+    case draco::DT_UINT16:
+      return 65535.0;
+    case draco::DT_INT16:
+      return 32767.0;
+    default:
+      return 0.0;
+  }
+}
+
+DracoAttribute read_attribute(const draco::Mesh& mesh, const DracoAttributeRef& ref,
+                              const std::string& name, const std::string& what,
+                              const std::string& attribute_name) {
+  const draco::PointAttribute* attribute = mesh.GetAttributeByUniqueId(ref.unique_id);
+  if (attribute == nullptr) {
+    fail(name, what,
+         attribute_name + " names Draco attribute " + std::to_string(ref.unique_id) +
+             ", which the stream does not hold");
+  }
+  DracoAttribute out;
+  out.components = attribute->num_components();
+  if (out.components < 1 || out.components > 4) {
+    fail(name, what, attribute_name + " has " + std::to_string(out.components) + " components");
+  }
+  // ConvertValue maps integers to [0, 1] itself only when the stream marks them normalized.
+  const double range =
+      ref.normalized && !attribute->normalized() ? integer_range(attribute->data_type()) : 0.0;
+  out.values.reserve(mesh.num_points() * static_cast<std::size_t>(out.components));
+  float value[4] = {};
+  for (draco::PointIndex point(0); point < mesh.num_points(); ++point) {
+    if (!attribute->ConvertValue<float>(attribute->mapped_index(point), value)) {
+      fail(name, what, attribute_name + ": a value does not convert to a number");
+    }
+    for (int c = 0; c < out.components; ++c) {
+      out.values.push_back(range > 0.0 ? std::max(value[c] / range, -1.0) : value[c]);
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<std::string> without_draco_indices(std::string_view bytes) {
+  if (bytes.find(kDracoExtension) == std::string_view::npos) return std::nullopt;
+  return bytes.substr(0, 4) == "glTF" ? rewrite_glb(bytes) : rewrite_json(bytes);
+}
+
+DracoPrimitive decode_draco(const unsigned char* bytes, std::size_t size,
+                            const std::map<std::string, DracoAttributeRef>& attributes,
+                            const std::string& name, const std::string& what) {
+  draco::DecoderBuffer buffer;
+  buffer.Init(reinterpret_cast<const char*>(bytes), size);
+  draco::Decoder decoder;
+  auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
+  if (!decoded.ok()) fail(name, what, "cannot decode: " + decoded.status().error_msg_string());
+  const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+  DracoPrimitive out;
+  out.vertex_count = mesh->num_points();
+  for (const auto& [attribute_name, ref] : attributes) {
+    out.attributes[attribute_name] = read_attribute(*mesh, ref, name, what, attribute_name);
+  }
+  out.corners.reserve(std::size_t{mesh->num_faces()} * 3);
+  for (draco::FaceIndex face(0); face < mesh->num_faces(); ++face) {
+    for (int corner = 0; corner < 3; ++corner)
+      out.corners.push_back(mesh->face(face)[corner].value());
+  }
+  return out;
+}
+
+}  // namespace covrast::detail

@@ -1,0 +1,50 @@
+// KHR_draco_mesh_compression for the glTF reader (mesh_gltf.cpp), on top of Debian's libdraco:
+// the JSON rewrite that lets tinygltf read such files, and the decoding of one compressed
+// primitive into per-vertex attribute values and triangle corners.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace covrast::detail {
+
+inline constexpr std::string_view kDracoExtension = "KHR_draco_mesh_compression";
+
+/// tinygltf 2.7 without its Draco option refuses a primitive whose "indices" accessor has no
+/// bufferView, which is how a Draco primitive says its indices live in the compressed stream.
+/// For a file (.gltf text or .glb) that names the extension, returns it with "indices" removed
+/// from every Draco primitive (the decoded faces replace them); nullopt for every other file
+/// and for JSON that does not parse (tinygltf then reports the syntax error).
+std::optional<std::string> without_draco_indices(std::string_view bytes);
+
+/// One glTF attribute of a decoded primitive: `components` values per vertex.
+struct DracoAttribute {
+  int components = 0;
+  std::vector<double> values;
+};
+
+struct DracoPrimitive {
+  std::size_t vertex_count = 0;
+  std::map<std::string, DracoAttribute> attributes;  ///< by glTF name ("POSITION", ...)
+  std::vector<std::uint32_t> corners;                ///< 3 per triangle, vertex numbers
+};
+
+/// What the glTF file says about one attribute of a Draco primitive: its unique id in the
+/// Draco stream, and whether its accessor is a normalized integer type (glTF 2.0, 3.11).
+struct DracoAttributeRef {
+  std::uint32_t unique_id = 0;
+  bool normalized = false;
+};
+
+/// Decodes the Draco mesh in `bytes` (the extension's bufferView). Throws InputError naming
+/// `name` and `what` (the primitive) when the stream does not decode or lacks an attribute.
+DracoPrimitive decode_draco(const unsigned char* bytes, std::size_t size,
+                            const std::map<std::string, DracoAttributeRef>& attributes,
+                            const std::string& name, const std::string& what);
+
+}  // namespace covrast::detail
