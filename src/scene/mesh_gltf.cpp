@@ -13,6 +13,8 @@
 #include "scene/gltf_pose.hpp"
 #include "scene/scene_internal.hpp"
 
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
 #include <tiny_gltf.h>
 
 #include <algorithm>
@@ -26,6 +28,23 @@
 
 namespace covrast::detail {
 namespace {
+
+/// Draco's static archive (CMakeLists.txt) holds its own copies of tinygltf and stb, in one
+/// object file. GNU ld takes an archive member to define a symbol that only shared libraries
+/// refer to, even when another shared library defines it: libtinygltf's calls into stb would
+/// pull Draco's copy, and with it a second tinygltf whose structures differ from the one
+/// covrast is compiled against (a crash on the first glTF file with an image). These
+/// references from covrast's own code bind stb's functions to libstb before the archive is
+/// searched; the ctest link_has_no_second_tinygltf checks the executable.
+[[maybe_unused]] __attribute__((used)) const void* const kStbFunctionsTinygltfCalls[] = {
+    reinterpret_cast<const void*>(&stbi_image_free),
+    reinterpret_cast<const void*>(&stbi_is_16_bit_from_memory),
+    reinterpret_cast<const void*>(&stbi_load_16_from_memory),
+    reinterpret_cast<const void*>(&stbi_load_from_memory),
+    reinterpret_cast<const void*>(&stbi_write_bmp_to_func),
+    reinterpret_cast<const void*>(&stbi_write_jpg_to_func),
+    reinterpret_cast<const void*>(&stbi_write_png_to_func),
+};
 
 /// tinygltf's messages can span several lines and quote raw bytes; ours are one printable
 /// line. A JSON syntax error ("... parse error at line L, column C: detail") becomes
