@@ -497,13 +497,14 @@ def model_scenes(opts, tmp, notes):
     """The framed scenes of the selected sample models (see find_models, select_models), as
     scene dicts; appends to notes (shown with the headline) what was measured, what was left
     out and why."""
-    models_dir = opts.models
-    if not os.path.isdir(models_dir):
+    # Shown relative to the repository (e.g. ../shared/models), never as this machine's path.
+    models_dir = os.path.relpath(opts.models, REPO)
+    if not os.path.isdir(opts.models):
         notes.append(f"Sample models: not found (`{models_dir}` does not exist), so the model "
                      "scenes are left out.")
         log(f"models: {models_dir} not found, skipped")
         return []
-    models, skipped = find_models(models_dir)
+    models, skipped = find_models(opts.models)
     if not models:
         notes.append(f"Sample models: none found in `{models_dir}`, so the model scenes are "
                      "left out.")
@@ -518,7 +519,7 @@ def model_scenes(opts, tmp, notes):
         except Failure as e:
             skipped.append((model["name"], str(e)))
             continue
-        shown = os.path.relpath(model["file"], models_dir)
+        shown = os.path.relpath(model["file"], opts.models)
         scenes.append({"name": f"model-{model['name']}", "path": path, "size": None,
                        "what": f"Sample model `{shown}` (in `{models_dir}`), framed by its "
                                "bounding box, per-triangle colours"})
