@@ -12,8 +12,8 @@
 
 #include <catch2/catch.hpp>
 
-#include "test_meshes.hpp"
 #include <glm/gtc/matrix_transform.hpp>
+#include "test_meshes.hpp"
 
 #include <algorithm>
 #include <array>

@@ -184,8 +184,8 @@ CaseResult run_case(const PlannedCase& plan, const BuildInfo& build) {
   return result;
 }
 
-std::vector<CaseResult> run_cases(const std::vector<PlannedCase>& plans, const TestArgs& args) {
-  const BuildInfo build = build_info();
+std::vector<CaseResult> run_cases(const std::vector<PlannedCase>& plans, const TestArgs& args,
+                                  const BuildInfo& build) {
   std::vector<CaseResult> results(plans.size());
   Progress progress(plans.size(), !args.quiet);
   // The cases run in parallel, one thread each (a lone case takes every thread): small CI
@@ -205,8 +205,7 @@ std::vector<CaseResult> run_cases(const std::vector<PlannedCase>& plans, const T
 
 /// --update: writes the goldens that need it (all with --all), each with its record.
 void update_goldens(const std::vector<PlannedCase>& plans, std::vector<CaseResult>& results,
-                    const TestArgs& args) {
-  const BuildInfo build = build_info();
+                    const TestArgs& args, const BuildInfo& build) {
   for (std::size_t i = 0; i < results.size(); ++i) {
     CaseResult& r = results[i];
     if (r.status == CaseStatus::Skipped) continue;
@@ -247,7 +246,8 @@ void write_artifacts(const std::filesystem::path& dir, const std::vector<CaseRes
   }
 }
 
-RunSummary summarize(const std::vector<CaseResult>& results, Clock::time_point start) {
+RunSummary summarize(const std::vector<CaseResult>& results, Clock::time_point start,
+                     const BuildInfo& b) {
   RunSummary s;
   for (const CaseResult& r : results) {
     s.skipped += r.status == CaseStatus::Skipped;
@@ -256,7 +256,6 @@ RunSummary summarize(const std::vector<CaseResult>& results, Clock::time_point s
     s.updated += r.updated;
   }
   s.seconds = std::chrono::duration<double>(Clock::now() - start).count();
-  const BuildInfo b = build_info();
   s.build_line =
       "covrast " + b.version + ", " + b.compiler + ", SIMD " + b.simd_target + ", " + b.cpu;
   return s;
@@ -303,9 +302,11 @@ int run_test(TestArgs args) {
   const Clock::time_point start = Clock::now();
   const Manifest manifest = load_manifest(args.manifest);
   const std::vector<PlannedCase> plans = plan_cases(select_cases(manifest, args), args);
-  std::vector<CaseResult> results = run_cases(plans, args);
-  if (args.update) update_goldens(plans, results, args);
-  const RunSummary summary = summarize(results, start);
+  // What rendered this run (it reads /proc/cpuinfo): once, for the records and the summary.
+  const BuildInfo build = build_info();
+  std::vector<CaseResult> results = run_cases(plans, args, build);
+  if (args.update) update_goldens(plans, results, args, build);
+  const RunSummary summary = summarize(results, start, build);
   if (!args.artifacts.empty()) write_artifacts(args.artifacts, results);
   if (!args.junit.empty()) write_junit(args.junit, manifest, results, summary);
   if (!args.report.empty()) write_html_report(args.report, manifest, results, summary);

@@ -13,7 +13,8 @@ RenderMode parse_render_mode(std::string_view text) {
     throw InputError("unknown mode '" + std::string(text) +
                      "': expected aliased, coverage, coverage-blend, ssaa:N, ssaa-grid:N or "
                      "ssaa-cmj:N (N = 1.." +
-                     std::to_string(kMaxSsaaSide) + "), msaa:K (K = 2, 4, 8, 16), reference or fxaa");
+                     std::to_string(kMaxSsaaSide) +
+                     "), msaa:K (K = 2, 4, 8, 16), reference or fxaa");
   };
   if (text == "aliased") return {ModeKind::Aliased, 1};
   if (text == "fxaa") return {ModeKind::Fxaa, 1};

@@ -194,7 +194,8 @@ class ABufferTile {
   /// Removes the fragments for which `drop(fragment)` holds from the pixel's list.
   template <class Drop>
   void remove_fragments(std::size_t pixel, Drop drop);
-  /// Turns a pixel's list into 256 sub-pixel samples (see PixelSamples) and frees it.
+  /// Turns a pixel's list into 256 sub-pixel samples (see PixelSamples) and frees it; the
+  /// caller then sets the pixel's depth bound (bound_by_samples).
   void to_samples(std::size_t pixel, int x, int y);
   /// Draws triangle `t` into a sampled pixel's samples: nearest wins, equal depth keeps the
   /// earlier triangle. Returns whether it won any sample.

@@ -23,7 +23,8 @@ bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const Trian
     return true;
   }
   to_samples(pixel, x, y);
-  if (add_to_samples(pixel, x, y, *t)) bound_by_samples(pixel);
+  add_to_samples(pixel, x, y, *t);
+  bound_by_samples(pixel);  // once the list and t are all in the samples
   return true;
 }
 
@@ -59,7 +60,6 @@ void ABufferTile::to_samples(std::size_t pixel, int x, int y) {
   }
   head_[pixel] = kEnd;
   open_count_[pixel] = closed_count_[pixel] = 0;
-  bound_by_samples(pixel);
 }
 
 void ABufferTile::bound_by_samples(std::size_t pixel) {
