@@ -166,8 +166,9 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
 }
 
 glm::dvec2 transform_duv(const TextureTransform& t, const glm::dvec2& d) {
-  const double c = std::cos(t.rotation), s = std::sin(t.rotation);
   const double x = d.x * t.scale.x, y = d.y * t.scale.y;
+  if (t.rotation == 0.0) return glm::dvec2(x, y);  // the common case: no trigonometry
+  const double c = std::cos(t.rotation), s = std::sin(t.rotation);
   return glm::dvec2(c * x + s * y, -s * x + c * y);
 }
 
