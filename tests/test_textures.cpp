@@ -594,3 +594,63 @@ TEST_CASE("textures: OBJ vt lines become corner UVs, v flipped to glTF's orienta
   write_file(dir / "bad.obj", "v 0 0 0\nvt 0 nan\n");
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "bad.obj"), Contains("bad.obj:2"));
 }
+
+namespace {
+
+/// A lit (Lambert) quad filling the image, with one texture slot set on its material by
+/// `set_slot`; the light rig is `lights`. Returns the centre pixel's red byte.
+template <class SetSlot>
+int lit_quad_red(const std::vector<covrast::Light>& lights, SetSlot set_slot) {
+  covrast::Scene scene = quad_scene(16, covrast::TextureSlot{});
+  covrast::Material material;
+  material.model = covrast::ShadingModel::Lambert;
+  set_slot(material);
+  scene.meshes[0].materials.assign(1, material);
+  for (const covrast::Light& light : lights) covrast::add_light(scene, light);
+  return render_mode(scene, "coverage").pixel(8, 8)[0];
+}
+
+covrast::TextureSlot solid_slot(std::uint8_t r, std::uint8_t g, std::uint8_t b, bool srgb) {
+  std::vector<std::uint8_t> rgba(16, 255);
+  for (std::size_t i = 0; i < 16; i += 4) {
+    rgba[i] = r;
+    rgba[i + 1] = g;
+    rgba[i + 2] = b;
+  }
+  covrast::TextureSlot slot;
+  slot.texture = covrast::make_texture("solid", 2, 2, rgba, srgb);
+  return slot;
+}
+
+}  // namespace
+
+TEST_CASE("textures: occlusion, emissive and normal textures in a lit scene", "[textures]") {
+  covrast::Light ambient;
+  ambient.type = covrast::LightType::Ambient;
+  ambient.intensity = 0.5;
+  const auto encoded = [](double linear) { return int(std::lround(srgb_encode_255(linear))); };
+  // Occlusion multiplies the ambient term: 1 + strength (R - 1) with R = 0.2.
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material&) {}) == encoded(0.5));
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.occlusion_texture = solid_slot(51, 0, 0, false);
+          }) == encoded(0.5 * 0.2));
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.occlusion_texture = solid_slot(51, 0, 0, false);
+            m.occlusion_texture.scale = 0.5f;
+          }) == encoded(0.5 * 0.6));
+  // Emission: factor x texture (sRGB 128), added.
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.emissive_linear = glm::vec3(0.5f);
+            m.emissive_texture = solid_slot(128, 128, 128, true);
+          }) == encoded(0.5 + 0.5 * srgb_decode(128)));
+  // A light grazing along +x does not light the flat quad; a normal map that turns the normal
+  // to the tangent (+x, from the UVs: u grows along +x) faces it: n_ts = (1, 0, 0) from texel
+  // (255, 128, 128) is (1, 0.004, 0.004) before normalising.
+  covrast::Light grazing;
+  grazing.direction = {-1.0, 0.0, 0.0};
+  REQUIRE(lit_quad_red({grazing}, [](covrast::Material&) {}) == 0);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(1.0, 1.0 / 255.0, 1.0 / 255.0));
+  REQUIRE(lit_quad_red({grazing}, [](covrast::Material& m) {
+            m.normal_texture = solid_slot(255, 128, 128, false);
+          }) == encoded(n.x));
+}
