@@ -654,3 +654,45 @@ TEST_CASE("textures: occlusion, emissive and normal textures in a lit scene", "[
             m.normal_texture = solid_slot(255, 128, 128, false);
           }) == encoded(n.x));
 }
+
+TEST_CASE("textures: TEXCOORD as normalized integers; a missing UV set is a warning",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(2, 2, 90));
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  // TEXCOORD_0: normalized unsigned short (v / 65535); TEXCOORD_1: normalized unsigned byte.
+  std::string u16, u8;
+  for (const std::uint16_t v : {0, 65535, 32768, 0, 65535, 65535}) covrast::test::put_u16(u16, v);
+  for (const std::uint8_t v : {0, 255, 51, 102, 255, 0}) covrast::test::put_u8(u8, v);
+  const int view16 = b.add_view(u16), view8 = b.add_view(u8);
+  b.gltf["accessors"].push_back({{"bufferView", view16},
+                                 {"componentType", 5123},
+                                 {"count", 3},
+                                 {"type", "VEC2"},
+                                 {"normalized", true}});
+  b.gltf["accessors"].push_back({{"bufferView", view8},
+                                 {"componentType", 5121},
+                                 {"count", 3},
+                                 {"type", "VEC2"},
+                                 {"normalized", true}});
+  const int uv0 = int(b.gltf["accessors"].size()) - 2, uv1 = uv0 + 1;
+  b.single_mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}},
+                  {"material", 0}},
+                 {{"attributes", {{"POSITION", pos}}}, {"material", 0}}});
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.gltf["textures"] = {{{"source", 0}}};
+  b.gltf["images"] = {{{"uri", "t.png"}}};
+  write_file(dir / "n.gltf", b.gltf_text());
+  const auto mesh = covrast::load_mesh(dir / "n.gltf");
+  REQUIRE(mesh->corner_texcoords[0].size() == 6);
+  REQUIRE(mesh->corner_texcoords[0][1] == glm::vec2(32768 / 65535.0f, 0.0f));
+  REQUIRE(mesh->corner_texcoords[1][1] == glm::vec2(0.2f, 0.4f));
+  REQUIRE(mesh->corner_texcoords[0][4] == glm::vec2(0.0f));  // the second primitive has none
+  write_file(dir / "s.json", R"({"width": 8, "height": 8, "camera": {"eye": [0, 0, 3],
+    "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40, "near": 0.1, "far": 10},
+    "meshes": [{"gltf": "n.gltf"}]})");
+  const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+  REQUIRE(scene.warnings.size() == 1);
+  REQUIRE_THAT(scene.warnings[0], Contains("1 primitives lack the TEXCOORD_n"));
+}

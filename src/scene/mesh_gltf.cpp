@@ -307,6 +307,11 @@ class GltfMeshBuilder {
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
+    if (missing_texcoords_ > 0) {
+      loaded.warnings.push_back(name_ + ": " + std::to_string(missing_texcoords_) +
+                                " primitives lack the TEXCOORD_n their material's textures use; "
+                                "UV (0, 0) used there");
+    }
     if (any_color_attribute_ || factors_differ_) {
       // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
       mesh_->colors_linear = std::move(colors_);
@@ -368,6 +373,7 @@ class GltfMeshBuilder {
     const std::uint32_t material = primitive.material >= 0
                                        ? static_cast<std::uint32_t>(primitive.material)
                                        : default_material_;
+    count_missing_texcoords(texture_attributes, material);
     if (placement.skin_joints.empty()) {
       for (const glm::dmat4& world : placement.worlds) {
         place(vertices, corners, colors, material, world, texture_attributes);
@@ -466,6 +472,18 @@ class GltfMeshBuilder {
                                                 : world_normals(vertices.normals, world),
                        base, first_index);
     add_corner_texture_attributes(texture_attributes, world, base, first_index);
+  }
+
+  /// Counts a primitive whose material samples a UV set the primitive does not have.
+  void count_missing_texcoords(const TextureAttributes& attributes, std::uint32_t material) {
+    const Material& m = mesh_->materials[material];
+    for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                    &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+      if (slot->texture && attributes.uv[slot->texcoord].empty()) {
+        ++missing_texcoords_;
+        return;
+      }
+    }
   }
 
   /// TEXCOORD_0 and _1 (VEC2 of float, or of normalized unsigned byte or short, or any type
@@ -809,6 +827,7 @@ class GltfMeshBuilder {
   std::shared_ptr<MeshData> mesh_;
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   bool any_normals_ = false;
+  std::size_t missing_texcoords_ = 0;  ///< primitives sampling a UV set they lack
   std::vector<FileCamera> cameras_;
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
   std::vector<bool> reached_;           ///< per node: in the walked scene
