@@ -10,6 +10,7 @@
 
 #include "core/shading_inputs.hpp"
 #include "core/texture_sampling.hpp"
+#include "scene/scene_internal.hpp"
 
 #include <turbojpeg.h>
 #include <catch2/catch.hpp>
@@ -695,4 +696,16 @@ TEST_CASE("textures: TEXCOORD as normalized integers; a missing UV set is a warn
   const covrast::Scene scene = covrast::load_scene(dir / "s.json");
   REQUIRE(scene.warnings.size() == 1);
   REQUIRE_THAT(scene.warnings[0], Contains("1 primitives lack the TEXCOORD_n"));
+}
+
+TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "k.png", png_bytes(3, 2, 64));
+  const auto texture =
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true);
+  REQUIRE(texture->levels[0].width == 3);
+  REQUIRE(texture->levels[0].texels[0].g == Approx(srgb_decode(64)).epsilon(1e-6));
+  REQUIRE_THROWS_WITH(
+      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
+      Contains("m.obj: map_Kd no.png: cannot read image"));
 }

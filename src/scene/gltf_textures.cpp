@@ -1,5 +1,6 @@
 // glTF textures (see gltf_textures.hpp; formulas and conventions in docs/textures.md).
 #include "scene/gltf_textures.hpp"
+#include "scene/scene_internal.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -102,6 +103,12 @@ glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fa
 }
 
 }  // namespace
+
+std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
+                                                 const std::string& name, bool srgb) {
+  const RgbaImage image = read_image(path, name);
+  return make_texture(name, image.width, image.height, image.rgba, srgb);
+}
 
 tinygltf::FsCallbacks regular_file_callbacks() {
   return tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_regular_file,
