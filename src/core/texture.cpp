@@ -87,6 +87,7 @@ std::shared_ptr<const Texture> make_texture(std::string name, int width, int hei
 namespace detail {
 
 int wrap_texel(long long i, int size, TextureWrap wrap) {
+  if (i >= 0 && i < size) return int(i);  // inside: every mode agrees, no division
   switch (wrap) {
     case TextureWrap::ClampToEdge:
       return int(std::clamp<long long>(i, 0, size - 1));
