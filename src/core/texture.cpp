@@ -103,6 +103,7 @@ int wrap_texel(long long i, int size, TextureWrap wrap) {
 }
 
 double texture_lod(const Texture& texture, const glm::dvec2& duv_dx, const glm::dvec2& duv_dy) {
+  if (texture.levels.empty()) return 0.0;
   const double w = texture.levels[0].width, h = texture.levels[0].height;
   const double rx = std::sqrt(duv_dx.x * w * (duv_dx.x * w) + duv_dx.y * h * (duv_dx.y * h));
   const double ry = std::sqrt(duv_dy.x * w * (duv_dy.x * w) + duv_dy.y * h * (duv_dy.y * h));
@@ -147,6 +148,7 @@ glm::dvec4 sample_level(const TextureLevel& level, const TextureSampler& sampler
 
 glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
                           const glm::dvec2& uv, double lod) {
+  if (texture.levels.empty()) return glm::dvec4(1.0);  // refused by check_scene; no crash
   const int last = int(texture.levels.size()) - 1;
   if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) {
     const TextureFilter filter = lod > 0.0 ? sampler.min : sampler.mag;

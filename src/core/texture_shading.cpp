@@ -46,7 +46,8 @@ namespace {
 /// of the transformed derivatives.
 glm::dvec4 lookup(const TextureSlot& slot, const TexturedCorners& corners, const double mu[3],
                   const WeightDerivatives& d) {
-  const glm::vec2* uv = corners.uv[slot.texcoord];
+  // check_scene refuses other sets; a scene built without it must still not read out of bounds.
+  const glm::vec2* uv = corners.uv[slot.texcoord == 1 ? 1 : 0];
   glm::dvec2 p(0.0), dx(0.0), dy(0.0);
   for (int k = 0; k < 3; ++k) {
     p += mu[k] * glm::dvec2(uv[k]);
