@@ -143,7 +143,8 @@ def main():
                 image, warnings = render_model(opts.covrast, safe, model_file, size, tmp,
                                                images_dir)
             except RuntimeError as e:
-                skipped.append((name, str(e)))
+                # Messages name files by their full path: the model's folder says enough.
+                skipped.append((name, str(e).replace(os.path.abspath(folder) + os.sep, "")))
                 continue
             shot = find_screenshot(folder)
             rows.append((name, os.path.relpath(image, docs),
@@ -158,9 +159,8 @@ def write_markdown(path, rows, skipped, size):
         "# Gallery: the glTF sample models, lit",
         "",
         "Written by `scripts/gallery.py` (not part of the test suite). Left: covrast, coverage "
-        f"mode, {size[0]}x{size[1]}, the file's materials (factors only: textures are not "
-        "rendered yet, so textured models show their base colour factor) under the script's "
-        "light rig. Right: the publisher's screenshot, linked from `../shared/models/gltf` "
+        f"mode, {size[0]}x{size[1]}, the file's materials and textures (docs/textures.md; "
+        "alpha modes not yet) under the script's light rig. Right: the publisher's screenshot, linked from `../shared/models/gltf` "
         "(not copied; licences vary per model). Framing, lights and materials differ from the "
         "publishers' viewers, so compare shapes and shading, not exact colours.",
         "",

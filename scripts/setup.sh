@@ -9,7 +9,7 @@ set -euo pipefail
 # Benchmark, so they are here too: two small header/library packages).
 build_packages=(
   cmake ninja-build g++ pkg-config
-  libglm-dev libtbb-dev libspng-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
+  libglm-dev libtbb-dev libspng-dev libturbojpeg0-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
   nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev libdraco-dev
 )
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for

@@ -1,5 +1,5 @@
 // covrast public API: images and their files. The last stage of the pipeline; the only
-// part of covrast that includes stb.
+// part of covrast that decodes or encodes image files.
 #pragma once
 
 #include <covrast/error.hpp>
@@ -60,5 +60,26 @@ inline constexpr std::size_t kMaxPngChunkBytes = std::size_t(1) << 26;
 /// up, alpha dropped, 16-bit samples reduced to their high byte). Throws InputError naming
 /// the file and the problem, also for files over the limits above or not regular files.
 Image read_png(const std::filesystem::path& path);
+
+/// 8-bit RGBA texels of a decoded image file (textures), row 0 at the top, 4 bytes a texel.
+struct RgbaImage {
+  int width = 0;
+  int height = 0;
+  std::vector<std::uint8_t> rgba;
+};
+
+/// Decodes a PNG (libspng) or JPEG (libturbojpeg) held in memory, recognised by its first
+/// bytes (the PNG signature, or the JPEG start-of-image marker FF D8 FF), never by a file
+/// name. PNG: any colour type and bit depth, tRNS applied as alpha, 16-bit samples reduced
+/// to their high byte. JPEG: baseline or progressive, grey or YCbCr (a CMYK file is refused),
+/// alpha 255; any corrupt-data warning is an error. The limits of read_png (kMaxPngSide,
+/// kMaxPngPixels) are checked from the header before anything is allocated. Throws
+/// InputError("NAME: cannot decode image: why").
+RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& name);
+
+/// decode_image of a whole file; refuses what is not a regular file (a FIFO would block).
+/// Throws InputError("NAME: cannot read image: why") when it cannot be read, with `name` as
+/// given (e.g. "model.gltf: image 2 (wood.png)").
+RgbaImage read_image(const std::filesystem::path& path, const std::string& name);
 
 }  // namespace covrast

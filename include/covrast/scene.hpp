@@ -6,6 +6,7 @@
 #pragma once
 
 #include <covrast/error.hpp>
+#include <covrast/texture.hpp>
 
 #include <glm/glm.hpp>
 
@@ -53,6 +54,15 @@ struct Material {
   /// material lights them with the normal as it is (glTF would cull them; covrast draws
   /// them, see docs/shading.md).
   bool double_sided = true;
+  // Textures (docs/textures.md); an empty slot changes nothing. baseColor multiplies the base
+  // colour (its alpha is kept for alpha modes); metallicRoughness: B x metallic, G x
+  // roughness; normal: tangent-space normal x (scale, scale, 1); occlusion: 1 + strength (R -
+  // 1) multiplies the ambient term only; emissive multiplies emissive_linear.
+  TextureSlot base_color_texture;  ///< sRGB texels
+  TextureSlot metallic_roughness_texture;
+  TextureSlot normal_texture;
+  TextureSlot occlusion_texture;
+  TextureSlot emissive_texture;  ///< sRGB texels
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
@@ -88,6 +98,13 @@ struct MeshData {
   /// differ between faces, as OBJ's vn allows); empty if the file has none. A zero vector
   /// means "no normal here": that triangle uses its face normal.
   std::vector<glm::vec3> corner_normals;
+  /// UV sets (glTF TEXCOORD_0 and _1, OBJ vt), 3 per triangle in index order like
+  /// corner_normals; empty if the file has none. glTF's convention: (0, 0) is the top-left
+  /// texel of the image (OBJ's v is flipped at load).
+  std::vector<glm::vec2> corner_texcoords[kMaxTexcoordSets];
+  /// Object-space tangents with the bitangent sign in w (glTF TANGENT), 3 per triangle in
+  /// index order; empty: computed per triangle from the normal texture's UVs.
+  std::vector<glm::vec4> corner_tangents;
   /// The file's materials (glTF materials; empty for OBJ) and each triangle's index into
   /// them (empty: every triangle uses materials[0], or the default material if none).
   std::vector<Material> materials;
@@ -220,6 +237,10 @@ struct MeshArrays {
   /// Optional normals: 3 per triangle in index order, finite; a zero vector means "use the
   /// face normal here" (MeshData::corner_normals).
   std::vector<glm::vec3> corner_normals{};
+  /// Optional UV sets 0 and 1: 3 per triangle in index order, finite (MeshData::
+  /// corner_texcoords).
+  std::vector<glm::vec2> corner_texcoords{};
+  std::vector<glm::vec2> corner_texcoords1{};
   /// Optional materials and each triangle's index into them (MeshData::materials and
   /// triangle_materials; checked like a scene file's "material": metallic and roughness in
   /// 0..1, shininess in 0.001..10000, colours finite and >= 0).

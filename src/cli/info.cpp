@@ -10,6 +10,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,18 @@ Bounds world_bounds(const Scene& scene) {
     }
   }
   return bounds;
+}
+
+/// The distinct textures the instance's materials use (docs/textures.md).
+std::size_t texture_count(const MeshInstance& instance) {
+  std::set<const Texture*> textures;
+  for (const Material& m : instance.materials) {
+    for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                    &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+      if (slot->texture) textures.insert(slot->texture.get());
+    }
+  }
+  return textures.size();
 }
 
 const char* color_source_name(ColorSource source) {
@@ -98,6 +111,9 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
     if (instance.color_source == ColorSource::Uniform) {
       m["color_linear"] = vec_json(glm::dvec3(instance.color_linear));
     }
+    if (const std::size_t textures = texture_count(instance); textures > 0) {
+      m["textures"] = textures;
+    }
     meshes.push_back(std::move(m));
   }
   j["meshes"] = std::move(meshes);
@@ -131,6 +147,9 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
               << color_source_name(instance.color_source);
     if (instance.color_source == ColorSource::Uniform) {
       std::cout << " " << vec_text(glm::dvec3(instance.color_linear)) << " (linear)";
+    }
+    if (const std::size_t textures = texture_count(instance); textures > 0) {
+      std::cout << " x " << textures << (textures == 1 ? " texture" : " textures");
     }
     std::cout << '\n';
   }

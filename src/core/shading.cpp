@@ -55,11 +55,11 @@ double schlick_weight(double cos_theta) {
   return m2 * m2 * m;
 }
 
-/// base x (ambient + sum_i E_i max(0, n . l_i)): Lambert without 1/pi, so that a light of
-/// intensity 1 facing the surface returns the base colour.
-glm::dvec3 diffuse_sum(const ShadingContext& c, const glm::dvec3& base, const glm::dvec3& p,
-                       const glm::dvec3& n) {
-  glm::dvec3 e = c.ambient;
+/// base x (ambient x occlusion + sum_i E_i max(0, n . l_i)): Lambert without 1/pi, so that a
+/// light of intensity 1 facing the surface returns the base colour.
+glm::dvec3 diffuse_sum(const ShadingContext& c, double occlusion, const glm::dvec3& base,
+                       const glm::dvec3& p, const glm::dvec3& n) {
+  glm::dvec3 e = c.ambient * occlusion;
   for (const PunctualLight& light : c.lights) {
     const Incident in = incident(light, p);
     e += in.irradiance * std::max(0.0, glm::dot(n, in.l));
@@ -84,14 +84,15 @@ glm::dvec3 blinn_phong_highlights(const SurfaceShading& s, const glm::dvec3& p, 
   return sum;
 }
 
-/// sum_i f(l_i, v) E_i (n . l_i)+ plus the ambient term ambient x ((1 - f0) c_diff + f0)
+/// sum_i f(l_i, v) E_i (n . l_i)+ plus the ambient term ambient x occlusion x ((1 - f0) c_diff
+/// + f0)
 /// (a uniform environment reflected by the normal-incidence albedo; a convention of
 /// covrast, not of the glTF specification, which has no ambient light).
 glm::dvec3 pbr_radiance(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
                         const glm::dvec3& n, const glm::dvec3& v) {
   const glm::dvec3 c_diff = base * (1.0 - s.metallic);
   const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - s.metallic) + base * s.metallic;
-  glm::dvec3 sum = s.context->ambient * ((glm::dvec3(1.0) - f0) * c_diff + f0);
+  glm::dvec3 sum = s.context->ambient * s.occlusion * ((glm::dvec3(1.0) - f0) * c_diff + f0);
   for (const PunctualLight& light : s.context->lights) {
     const Incident in = incident(light, p);
     const double n_dot_l = glm::dot(n, in.l);
@@ -145,9 +146,10 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
     case LitModel::Unlit:
       return base;
     case LitModel::Lambert:
-      return diffuse_sum(c, base, p, n) + s.emissive;
+      return diffuse_sum(c, s.occlusion, base, p, n) + s.emissive;
     case LitModel::BlinnPhong:
-      return diffuse_sum(c, base, p, n) + blinn_phong_highlights(s, p, n, v) + s.emissive;
+      return diffuse_sum(c, s.occlusion, base, p, n) + blinn_phong_highlights(s, p, n, v) +
+             s.emissive;
     case LitModel::Pbr:
     default:
       return pbr_radiance(s, base, p, n, v) + s.emissive;
@@ -167,7 +169,15 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
                  mu2 * glm::dvec3(r.normal_world[2]);
   const double n_length = glm::length(n);
   n = n_length > 0.0 ? n * (1.0 / n_length) : glm::dvec3(0.0);
-  return glm::vec3(shade_point(*r.surface, base, p, n));
+  if (r.textured == nullptr) return glm::vec3(shade_point(*r.surface, base, p, n));
+  // Textured: the surface with this point's texels (core/texture_shading.cpp).
+  const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n);
+  SurfaceShading s = *r.surface;
+  s.metallic = sample.metallic;
+  s.roughness = sample.roughness;
+  s.occlusion = sample.occlusion;
+  s.emissive = sample.emissive;
+  return glm::vec3(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal));
 }
 
 }  // namespace covrast::detail

@@ -7,6 +7,8 @@
 
 #include "core/triangle_setup.hpp"
 
+#include <covrast/texture.hpp>
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
@@ -39,6 +41,15 @@ struct ShadingContext {
   std::vector<PunctualLight> lights;
 };
 
+/// A material's non-empty texture slots (pointers into the scene's Material; null: none).
+struct SurfaceTextures {
+  const TextureSlot* base_color = nullptr;
+  const TextureSlot* metallic_roughness = nullptr;
+  const TextureSlot* normal = nullptr;
+  const TextureSlot* occlusion = nullptr;
+  const TextureSlot* emissive = nullptr;
+};
+
 /// One material of one mesh instance, resolved (scene overrides applied).
 struct SurfaceShading {
   LitModel model = LitModel::Lambert;
@@ -48,7 +59,20 @@ struct SurfaceShading {
   glm::dvec3 specular{0.5};  ///< blinn-phong
   double shininess = 32.0;   ///< blinn-phong exponent
   bool double_sided = true;  ///< back faces get the flipped normal (front end)
+  /// Multiplies the ambient term only (the occlusion texture sets it per shading point).
+  double occlusion = 1.0;
   const ShadingContext* context = nullptr;
+  /// The textures this surface samples; null for an untextured one (no per-pixel texture
+  /// work at all), and for an Unlit one without a base colour texture.
+  const SurfaceTextures* textures = nullptr;
+};
+
+/// What a textured triangle adds to its ShadingRecord, in the TriangleSetup's vertex order:
+/// both UV sets, and world-space tangents with the bitangent sign in w (the file's, or the
+/// triangle's own from its UV derivatives; zero when neither exists).
+struct TexturedCorners {
+  glm::vec2 uv[kMaxTexcoordSets][3];
+  glm::vec4 tangent_world[3];
 };
 
 /// Per set-up triangle, in the TriangleSetup's vertex order. Normals are unit length and
@@ -57,7 +81,32 @@ struct ShadingRecord {
   glm::vec3 position_world[3];
   glm::vec3 normal_world[3];
   const SurfaceShading* surface;
+  const TexturedCorners* textured = nullptr;  ///< null unless surface->textures
 };
+
+/// The textures' contribution at one shading point (core/texture_shading.cpp).
+struct SurfaceSample {
+  glm::dvec4 base_color{1.0};  ///< multiplies the base colour; alpha for the alpha modes
+  double metallic = 1.0;       ///< the surface's, times the texture's B
+  double roughness = 1.0;      ///< the surface's, times the texture's G
+  double occlusion = 1.0;      ///< 1 + strength (R - 1)
+  glm::dvec3 emissive{0.0};    ///< the surface's, times the emissive texture
+  glm::dvec3 normal{0.0};      ///< unit, world space; the normal map applied
+};
+
+/// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
+/// the level of detail from the exact screen-space derivatives of each UV set there;
+/// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
+SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
+                             const glm::dvec3& normal);
+
+/// d(mu_i)/dx and d(mu_i)/dy of the perspective-correct barycentric weights of `t` at the
+/// point whose weights are mu0..mu2 (docs/textures.md has the derivation).
+struct WeightDerivatives {
+  double dx[3];
+  double dy[3];
+};
+WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double mu1, double mu2);
 
 /// Outgoing linear radiance at world point `p` with unit normal `n` (zero: no normal) and
 /// base colour `base` (linear): the material's model, summed over the context's lights.

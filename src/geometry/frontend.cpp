@@ -140,6 +140,10 @@ inline SnappedVertex snapped_vertex(double x_fx8, double y_fx8, double z_window,
 // way. Not detected: a single surface that passes through itself with part of it turned
 // inside out (negative winding); such a mesh is not a valid solid.
 
+namespace {
+bool shows_textures(const Scene& scene);
+}  // namespace
+
 GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_px,
                                    bool cull_hidden_backfaces)
     : scene_(scene),
@@ -175,7 +179,7 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       vertices_[i].color_linear.resize(scene.meshes[i].mesh->positions.size());
     }
   }
-  if (scene.lit) prepare_lighting();
+  if (scene.lit || shows_textures(scene)) prepare_lighting();
 }
 
 namespace {
@@ -208,6 +212,35 @@ PunctualLight punctual_light(const Light& light) {
   return p;
 }
 
+/// The texture slots a material shows: all of them when it is lit, only the base colour's
+/// when unlit (ShadingModel::Unlit, or a scene without lights).
+SurfaceTextures surface_textures(const Material& m, bool lit) {
+  const auto slot = [](const TextureSlot& t) { return t ? &t : nullptr; };
+  SurfaceTextures out;
+  out.base_color = slot(m.base_color_texture);
+  if (!lit || m.model == ShadingModel::Unlit) return out;
+  out.metallic_roughness = slot(m.metallic_roughness_texture);
+  out.normal = slot(m.normal_texture);
+  out.occlusion = slot(m.occlusion_texture);
+  out.emissive = slot(m.emissive_texture);
+  return out;
+}
+
+bool any_texture(const SurfaceTextures& t) {
+  return t.base_color != nullptr || t.metallic_roughness != nullptr || t.normal != nullptr ||
+         t.occlusion != nullptr || t.emissive != nullptr;
+}
+
+/// Whether some instance shows a texture: an unlit scene then needs the shaded path too.
+bool shows_textures(const Scene& scene) {
+  for (const MeshInstance& instance : scene.meshes) {
+    for (const Material& m : instance.materials) {
+      if (any_texture(surface_textures(m, scene.lit))) return true;
+    }
+  }
+  return false;
+}
+
 SurfaceShading surface_shading(const Material& m, const ShadingContext* context) {
   SurfaceShading s;
   s.model = LitModel(int(m.model));
@@ -238,16 +271,26 @@ void GeometryFrontEnd::prepare_lighting() {
     }
   }
   surfaces_.resize(scene_.meshes.size());
+  textures_.resize(scene_.meshes.size());
   lit_.assign(scene_.meshes.size(), false);
   for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
-    for (const Material& m : scene_.meshes[i].materials) {
-      surfaces_[i].push_back(surface_shading(m, &context_));
-      if (m.model != ShadingModel::Unlit) lit_[i] = true;
+    const std::vector<Material>& materials = scene_.meshes[i].materials;
+    // All slots first: surfaces_ point into textures_[i], which must not move afterwards.
+    for (const Material& m : materials) textures_[i].push_back(surface_textures(m, scene_.lit));
+    for (std::size_t k = 0; k < materials.size(); ++k) {
+      SurfaceShading surface = surface_shading(materials[k], &context_);
+      if (!scene_.lit) surface.model = LitModel::Unlit;  // textured in a scene without lights
+      if (any_texture(textures_[i][k])) surface.textures = &textures_[i][k];
+      surfaces_[i].push_back(surface);
+      if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
+        lit_[i] = true;
+      }
     }
     if (surfaces_[i].empty()) surfaces_[i].push_back(surface_shading(Material{}, &context_));
     if (lit_[i]) vertices_[i].position_world.resize(scene_.meshes[i].mesh->positions.size());
   }
   chunk_shading_.resize(chunk_count());
+  chunk_textured_.resize(chunk_count());
 }
 
 unsigned GeometryFrontEnd::cullable_facing(const MeshInstance& instance, const glm::dvec3& eye) {
@@ -440,6 +483,8 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   if (!chunk_shading_.empty()) {
     chunk_shading_[chunk].clear();
     sink.shading = &chunk_shading_[chunk];
+    chunk_textured_[chunk].clear();
+    sink.textured = &chunk_textured_[chunk];
   }
   // The instance holding `first`: first_triangle_ is sorted, find the last entry <= first.
   std::size_t instance =
@@ -588,7 +633,8 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     // are hidden back faces).
     ShadeVertex computed[3];
     if (lazy != nullptr) {
-      shade_vertices(lazy->instance, lazy->local, *lazy->normal_matrix, lazy->det_sign, computed);
+      shade_vertices(lazy->instance, lazy->local, *lazy->normal_matrix, *lazy->linear,
+                     lazy->det_sign, *lit, computed);
       shade = computed;
     }
     ShadingRecord& record = sink.shading->emplace_back();
@@ -603,6 +649,17 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
       record.normal_world[k] = sign * ordered[k]->normal_world;
     }
     record.surface = lit;
+    record.textured = nullptr;
+    if (lit->textures != nullptr) {
+      // The tangent turns with the normal (xyz and the bitangent sign): the whole frame of a
+      // back face is the front's mirrored, so its perturbed normal is the front's negated.
+      TexturedCorners& corners = sink.textured->emplace_back();
+      for (int k = 0; k < 3; ++k) {
+        for (int set = 0; set < kMaxTexcoordSets; ++set) corners.uv[set][k] = ordered[k]->uv[set];
+        corners.tangent_world[k] = sign * ordered[k]->tangent_world;
+      }
+      record.textured = &corners;
+    }
     t.shading = &record;
     t.flat_color = false;
   }
@@ -647,6 +704,11 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
               a_in.position_world + float(t) * (a_out.position_world - a_in.position_world);
           next[n].shade.normal_world =
               a_in.normal_world + float(t) * (a_out.normal_world - a_in.normal_world);
+          for (int set = 0; set < kMaxTexcoordSets; ++set) {
+            next[n].shade.uv[set] = a_in.uv[set] + float(t) * (a_out.uv[set] - a_in.uv[set]);
+          }
+          next[n].shade.tangent_world =
+              a_in.tangent_world + float(t) * (a_out.tangent_world - a_in.tangent_world);
         }
         ++n;
       }
@@ -678,7 +740,8 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
 }
 
 void GeometryFrontEnd::shade_vertices(std::size_t instance, std::size_t local,
-                                      const glm::dmat3& normal_matrix, double det_sign,
+                                      const glm::dmat3& normal_matrix, const glm::dmat3& linear,
+                                      double det_sign, const SurfaceShading& surface,
                                       ShadeVertex out[3]) const {
   const MeshInstance& inst = scene_.meshes[instance];
   const std::uint32_t* idx = inst.mesh->indices.data() + local * 3;
@@ -702,6 +765,48 @@ void GeometryFrontEnd::shade_vertices(std::size_t instance, std::size_t local,
     }
     out[k].normal_world = glm::vec3(n);
   }
+  if (surface.textures != nullptr) texture_vertices(inst, local, linear, det_sign, surface, out);
+}
+
+// Tangents (glTF 2.0, 3.7.2.1 TANGENT): the file's are vectors, t_world = M t, and their
+// bitangent sign turns with a mirroring M (cross(M n, M t) = det(M) M^-T cross(n, t)).
+// Without them, the triangle's own from the normal texture's UV set (world positions p_k,
+// UVs (u_k, v_k)): with e1 = p1 - p0, e2 = p2 - p0 and the UV differences (du1, dv1),
+// (du2, dv2), T = (e1 dv2 - e2 dv1) / r and B = (e2 du1 - e1 du2) / r, r = du1 dv2 - du2 dv1
+// (Lengyel, "Computing Tangent Space Basis Vectors", 2001); w = sign((n x T) . B), with n the
+// face normal.
+void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t local,
+                                        const glm::dmat3& linear, double det_sign,
+                                        const SurfaceShading& surface, ShadeVertex out[3]) const {
+  const MeshData& mesh = *inst.mesh;
+  for (int set = 0; set < kMaxTexcoordSets; ++set) {
+    const std::vector<glm::vec2>& uvs = mesh.corner_texcoords[set];
+    for (int k = 0; k < 3; ++k) {
+      out[k].uv[set] = uvs.empty() ? glm::vec2(0.0f) : uvs[local * 3 + std::size_t(k)];
+    }
+  }
+  for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(0.0f);
+  if (surface.textures->normal == nullptr) return;
+  if (!mesh.corner_tangents.empty()) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec4& t = mesh.corner_tangents[local * 3 + std::size_t(k)];
+      const glm::dvec3 t_world = linear * glm::dvec3(t);
+      out[k].tangent_world = glm::vec4(glm::vec3(t_world), float(t.w * det_sign));
+    }
+    return;
+  }
+  const int set = surface.textures->normal->texcoord;
+  const glm::dvec3 e1 = glm::dvec3(out[1].position_world) - glm::dvec3(out[0].position_world);
+  const glm::dvec3 e2 = glm::dvec3(out[2].position_world) - glm::dvec3(out[0].position_world);
+  const glm::dvec2 d1 = glm::dvec2(out[1].uv[set]) - glm::dvec2(out[0].uv[set]);
+  const glm::dvec2 d2 = glm::dvec2(out[2].uv[set]) - glm::dvec2(out[0].uv[set]);
+  const double r = d1.x * d2.y - d2.x * d1.y;
+  if (!(std::abs(r) > 0.0)) return;  // degenerate UVs: no tangent, no normal map
+  const glm::dvec3 tangent = (e1 * d2.y - e2 * d1.y) / r;
+  const glm::dvec3 bitangent = (e2 * d1.x - e1 * d2.x) / r;
+  const glm::dvec3 face = glm::cross(e1, e2) * det_sign;
+  const float w = glm::dot(glm::cross(face, tangent), bitangent) < 0.0 ? -1.0f : 1.0f;
+  for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(glm::vec3(tangent), w);
 }
 
 void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end,
@@ -744,15 +849,16 @@ void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std:
       ++sink.counters.culled;
       continue;
     }
-    const bool unlit = lit->model == LitModel::Unlit;
+    // Unlit and untextured: no shading inputs at all, the unlit path bit for bit.
+    const bool unlit = lit->model == LitModel::Unlit && lit->textures == nullptr;
     if ((o0 | o1 | o2) == 0) {
-      const LazyShade lazy{instance, local, &normal_matrix, det_sign};
+      const LazyShade lazy{instance, local, &normal_matrix, &linear, det_sign};
       emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]],
                     color[0], color[1], color[2], flat, primitive, std::uint32_t(instance), sink,
                     nullptr, unlit ? nullptr : lit, &lazy);
     } else {
       ShadeVertex shade[3];
-      if (!unlit) shade_vertices(instance, local, normal_matrix, det_sign, shade);
+      if (!unlit) shade_vertices(instance, local, normal_matrix, linear, det_sign, *lit, shade);
       clip_triangle(instance, mvp, indices, color, flat, o0 | o1 | o2, primitive, sink,
                     unlit ? nullptr : shade, unlit ? nullptr : lit);
     }

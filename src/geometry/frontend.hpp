@@ -111,26 +111,32 @@ class ChunkSetups {
 struct ShadeVertex {
   glm::vec3 position_world;
   glm::vec3 normal_world;
+  /// Textured triangles only (TexturedCorners): both UV sets and the world tangent.
+  glm::vec2 uv[kMaxTexcoordSets];
+  glm::vec4 tangent_world;
 };
 
-/// One chunk's ShadingRecords: fixed blocks, so a record's address (TriangleSetup::shading)
-/// stays valid while more are added; the blocks are kept from frame to frame.
-class ShadingArena {
+/// One chunk's ShadingRecords (or TexturedCorners): fixed blocks, so a record's address
+/// (TriangleSetup::shading) stays valid while more are added; the blocks are kept from frame
+/// to frame.
+template <class Record>
+class RecordArena {
  public:
   void clear() { size_ = 0; }
-  ShadingRecord& emplace_back() {
+  Record& emplace_back() {
     const std::size_t block = size_ / kBlockRecords;
-    if (block == blocks_.size())
-      blocks_.push_back(std::make_unique<ShadingRecord[]>(kBlockRecords));
+    if (block == blocks_.size()) blocks_.push_back(std::make_unique<Record[]>(kBlockRecords));
     return blocks_[block][size_++ % kBlockRecords];
   }
   std::size_t size() const { return size_; }
 
  private:
-  static constexpr std::size_t kBlockRecords = 4096;  ///< 320 KiB per block
-  std::vector<std::unique_ptr<ShadingRecord[]>> blocks_;
+  static constexpr std::size_t kBlockRecords = 4096;  ///< 352 KiB per block of ShadingRecord
+  std::vector<std::unique_ptr<Record[]>> blocks_;
   std::size_t size_ = 0;
 };
+using ShadingArena = RecordArena<ShadingRecord>;
+using TexturedArena = RecordArena<TexturedCorners>;
 
 struct SetupCounters {
   std::uint64_t culled = 0;           ///< outside the view volume, zero area after snapping, or a
@@ -165,8 +171,9 @@ class GeometryFrontEnd {
     return vertices_[instance];
   }
 
-  /// Whether an instance is lit: the scene has lights and some material of the instance is
-  /// not ShadingModel::Unlit. Unlit instances take the unlit path bit for bit.
+  /// Whether an instance takes the shaded path (ShadingRecords): the scene has lights and some
+  /// material of the instance is not ShadingModel::Unlit, or some material shows a texture
+  /// (lit or not). Other instances take the unlit path bit for bit.
   bool instance_lit(std::size_t instance) const { return !lit_.empty() && lit_[instance]; }
 
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order. The
@@ -194,8 +201,9 @@ class GeometryFrontEnd {
     /// Facings dropped as hidden back faces for the current instance: kDropClockwise,
     /// kDropCounterClockwise or 0.
     unsigned drop_facing = 0;
-    bool convex_surface = false;      ///< the instance's TriangleSetup::convex_surface
-    ShadingArena* shading = nullptr;  ///< where lit triangles' records go
+    bool convex_surface = false;        ///< the instance's TriangleSetup::convex_surface
+    ShadingArena* shading = nullptr;    ///< where lit triangles' records go
+    TexturedArena* textured = nullptr;  ///< where textured triangles' corners go
     /// The instance's model matrix has a negative determinant: its front faces (counter-
     /// clockwise in the file) are clockwise on screen.
     bool mirrored = false;
@@ -207,6 +215,7 @@ class GeometryFrontEnd {
     std::size_t instance;
     std::size_t local;
     const glm::dmat3* normal_matrix;
+    const glm::dmat3* linear;  ///< the model matrix's 3x3 part (tangents)
     double det_sign;
   };
   /// `lit`: a lit triangle's material, null for unlit ones; its ShadeVertex of v0, v1, v2 are
@@ -225,9 +234,14 @@ class GeometryFrontEnd {
   /// The triangles [g, end) of a lit instance (setup_range's loop with shading inputs).
   void setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end, Sink& sink) const;
   /// The three ShadeVertex of triangle `local` of a lit instance (`normal_matrix`: the
-  /// inverse transpose of the model matrix's 3x3 part, `det_sign` the sign of its determinant).
+  /// inverse transpose of the model matrix's 3x3 part `linear`, `det_sign` the sign of its
+  /// determinant); with UVs and tangents when `surface` is textured.
   void shade_vertices(std::size_t instance, std::size_t local, const glm::dmat3& normal_matrix,
-                      double det_sign, ShadeVertex out[3]) const;
+                      const glm::dmat3& linear, double det_sign, const SurfaceShading& surface,
+                      ShadeVertex out[3]) const;
+  /// The UVs and world tangents of a textured triangle's corners (shade_vertices).
+  void texture_vertices(const MeshInstance& inst, std::size_t local, const glm::dmat3& linear,
+                        double det_sign, const SurfaceShading& surface, ShadeVertex out[3]) const;
   /// Builds context_, surfaces_ and lit_ from the scene (constructor, lit scenes only).
   void prepare_lighting();
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
@@ -260,8 +274,11 @@ class GeometryFrontEnd {
   // context_; chunk_shading_[c]: the records of chunk c, written only by setup_chunk(c).
   ShadingContext context_;
   std::vector<std::vector<SurfaceShading>> surfaces_;
+  /// textures_[i][m]: instance i's material m's slots, where surfaces_[i][m].textures points.
+  std::vector<std::vector<SurfaceTextures>> textures_;
   std::vector<bool> lit_;
   mutable std::vector<ShadingArena> chunk_shading_;
+  mutable std::vector<TexturedArena> chunk_textured_;
 };
 
 }  // namespace covrast::detail

@@ -1,5 +1,7 @@
 // Image files: the last stage of the pipeline and the only code in covrast that encodes or
-// decodes them. PNG goes through libspng (with zlib), a decoder built for untrusted input.
+// decodes them. PNG goes through libspng (with zlib), JPEG through libturbojpeg: decoders
+// built for untrusted input, whose headers are read and checked against covrast's limits
+// before any pixel memory is allocated.
 //
 // Every writer first encodes the whole file in memory, then writes it atomically: the bytes
 // go into "<name>.tmp-<pid>-<random>" beside the target (same directory, so the same file
@@ -23,6 +25,7 @@
 #include <covrast/image.hpp>
 
 #include <spng.h>
+#include <turbojpeg.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -37,6 +40,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <functional>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -359,6 +363,136 @@ Image read_png(const std::filesystem::path& path) {
     return fail(spng_strerror(error));
   }
   return image;
+}
+
+namespace {
+
+constexpr std::uint8_t kPngSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
+
+/// The size limits of read_png, from a header's dimensions; empty when they pass.
+std::string over_limits(std::uint64_t width, std::uint64_t height) {
+  if (width == 0 || height == 0) return "image is empty";
+  if (width > std::uint64_t(kMaxPngSide) || height > std::uint64_t(kMaxPngSide) ||
+      width * height > kMaxPngPixels) {
+    return std::to_string(width) + "x" + std::to_string(height) + " is more than the " +
+           std::to_string(kMaxPngPixels) + " pixels (sides up to " + std::to_string(kMaxPngSide) +
+           ") covrast reads";
+  }
+  return {};
+}
+
+/// PNG from memory through libspng, as RGBA8 with tRNS applied.
+RgbaImage decode_png_rgba(const std::uint8_t* bytes, std::size_t size,
+                          const std::function<void(const std::string&)>& fail) {
+  const SpngContext png(0);
+  spng_ctx* ctx = png.get();
+  spng_set_image_limits(ctx, std::uint32_t(kMaxPngSide), std::uint32_t(kMaxPngSide));
+  spng_set_chunk_limits(ctx, kMaxPngChunkBytes, kMaxPngChunkBytes);
+  spng_set_png_buffer(ctx, bytes, size);
+  spng_ihdr ihdr{};
+  if (const int error = spng_get_ihdr(ctx, &ihdr); error != 0) fail(spng_strerror(error));
+  if (const std::string why = over_limits(ihdr.width, ihdr.height); !why.empty()) fail(why);
+  std::size_t out_size = 0;
+  if (const int error = spng_decoded_image_size(ctx, SPNG_FMT_RGBA8, &out_size); error != 0) {
+    fail(spng_strerror(error));
+  }
+  RgbaImage image;
+  image.width = int(ihdr.width);
+  image.height = int(ihdr.height);
+  image.rgba.resize(out_size);
+  if (const int error =
+          spng_decode_image(ctx, image.rgba.data(), out_size, SPNG_FMT_RGBA8, SPNG_DECODE_TRNS);
+      error != 0) {
+    fail(spng_strerror(error));
+  }
+  return image;
+}
+
+/// Owns a libturbojpeg decompressor.
+class TurboJpeg {
+ public:
+  TurboJpeg() : handle_(tjInitDecompress()) {
+    if (handle_ == nullptr) throw std::bad_alloc();
+  }
+  ~TurboJpeg() { tjDestroy(handle_); }
+  TurboJpeg(const TurboJpeg&) = delete;
+  TurboJpeg& operator=(const TurboJpeg&) = delete;
+  tjhandle get() const { return handle_; }
+
+ private:
+  tjhandle handle_;
+};
+
+/// JPEG from memory through libturbojpeg, as RGBA8 (alpha 255). TJFLAG_STOPONWARNING makes a
+/// corrupt or truncated stream an error instead of a partly grey image.
+RgbaImage decode_jpeg_rgba(const std::uint8_t* bytes, std::size_t size,
+                           const std::function<void(const std::string&)>& fail) {
+  if (size > std::size_t(0xFFFFFFFFu)) fail("file too large");
+  const TurboJpeg jpeg;
+  int width = 0, height = 0, subsampling = 0, colorspace = 0;
+  if (tjDecompressHeader3(jpeg.get(), bytes, static_cast<unsigned long>(size), &width, &height,
+                          &subsampling, &colorspace) != 0) {
+    fail(tjGetErrorStr2(jpeg.get()));
+  }
+  if (width <= 0 || height <= 0) fail("image is empty");
+  if (const std::string why = over_limits(std::uint64_t(width), std::uint64_t(height));
+      !why.empty()) {
+    fail(why);
+  }
+  if (colorspace == TJCS_CMYK || colorspace == TJCS_YCCK) fail("CMYK JPEG is not supported");
+  RgbaImage image;
+  image.width = width;
+  image.height = height;
+  image.rgba.resize(std::size_t(width) * std::size_t(height) * 4);
+  if (tjDecompress2(jpeg.get(), bytes, static_cast<unsigned long>(size), image.rgba.data(), width,
+                    0, height, TJPF_RGBA, TJFLAG_ACCURATEDCT | TJFLAG_STOPONWARNING) != 0) {
+    fail(tjGetErrorStr2(jpeg.get()));
+  }
+  return image;
+}
+
+}  // namespace
+
+RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& name) {
+  const std::function<void(const std::string&)> fail = [&](const std::string& why) {
+    throw InputError(name + ": cannot decode image: " + why);
+  };
+  if (size >= sizeof kPngSignature &&
+      std::memcmp(bytes, kPngSignature, sizeof kPngSignature) == 0) {
+    return decode_png_rgba(bytes, size, fail);
+  }
+  if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
+    return decode_jpeg_rgba(bytes, size, fail);
+  }
+  fail(size == 0 ? "empty" : "neither PNG nor JPEG (by its first bytes)");
+  return {};
+}
+
+RgbaImage read_image(const std::filesystem::path& path, const std::string& name) {
+  const auto fail = [&](const std::string& why) {
+    throw InputError(name + ": cannot read image: " + why);
+  };
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    fail("not a regular file");
+  }
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) fail(errno_message(errno));
+  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(file, std::fclose);
+  // Bounded: an image over the limits is refused from its header anyway, and no PNG or JPEG
+  // of at most kMaxPngPixels needs more than this many bytes.
+  constexpr std::size_t kMaxImageFileBytes = std::size_t(1) << 30;
+  Bytes bytes;
+  std::uint8_t buffer[1 << 16];
+  for (;;) {
+    const std::size_t n = std::fread(buffer, 1, sizeof buffer, file);
+    bytes.insert(bytes.end(), buffer, buffer + n);
+    if (bytes.size() > kMaxImageFileBytes) fail("file larger than 1 GiB");
+    if (n < sizeof buffer) break;
+  }
+  if (std::ferror(file)) fail(errno_message(errno));
+  return decode_image(bytes.data(), bytes.size(), name);
 }
 
 }  // namespace covrast

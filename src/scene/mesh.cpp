@@ -67,6 +67,13 @@ std::size_t drop_nonfinite_triangles(MeshData& mesh) {
     if (normals)
       std::copy_n(mesh.corner_normals.begin() + std::ptrdiff_t(t), 3,
                   mesh.corner_normals.begin() + std::ptrdiff_t(kept));
+    for (std::vector<glm::vec2>& uv : mesh.corner_texcoords) {
+      if (!uv.empty())
+        std::copy_n(uv.begin() + std::ptrdiff_t(t), 3, uv.begin() + std::ptrdiff_t(kept));
+    }
+    if (!mesh.corner_tangents.empty())
+      std::copy_n(mesh.corner_tangents.begin() + std::ptrdiff_t(t), 3,
+                  mesh.corner_tangents.begin() + std::ptrdiff_t(kept));
     if (materials) mesh.triangle_materials[kept / 3] = mesh.triangle_materials[t / 3];
     mesh.indices[kept++] = a;
     mesh.indices[kept++] = b;
@@ -74,6 +81,10 @@ std::size_t drop_nonfinite_triangles(MeshData& mesh) {
   }
   mesh.indices.resize(kept);
   if (normals) mesh.corner_normals.resize(kept);
+  for (std::vector<glm::vec2>& uv : mesh.corner_texcoords) {
+    if (!uv.empty()) uv.resize(kept);
+  }
+  if (!mesh.corner_tangents.empty()) mesh.corner_tangents.resize(kept);
   if (materials) mesh.triangle_materials.resize(kept / 3);
   for (std::size_t i = 0; i < mesh.positions.size(); ++i) {
     if (bad[i]) mesh.positions[i] = glm::vec3(0.0f);

@@ -11,6 +11,7 @@
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
 #include "scene/gltf_pose.hpp"
+#include "scene/gltf_textures.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <stb/stb_image.h>
@@ -113,12 +114,6 @@ glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, 
   return t * r * s;
 }
 
-/// Images are irrelevant to covrast: accept them without decoding.
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;
-}
-
 float clamp_unit(double value) {
   if (!(value > 0.0)) return 0.0f;  // also NaN
   return value >= 1.0 ? 1.0f : static_cast<float>(value);
@@ -134,10 +129,10 @@ double extension_number(const tinygltf::ExtensionMap& extensions, const char* ex
   return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
 }
 
-/// A glTF material as covrast shades it (glTF 2.0, 3.9 and 5.19; factors only, textures are
-/// the next step): pbrMetallicRoughness' metallic and roughness factors, emissiveFactor x
-/// KHR_materials_emissive_strength, doubleSided; KHR_materials_unlit selects ShadingModel::
-/// Unlit. The base colour factor goes into the colour selection, as unlit.
+/// A glTF material's factors as covrast shades them (glTF 2.0, 3.9 and 5.19; the textures
+/// come from GltfTextures::apply): pbrMetallicRoughness' metallic and roughness factors,
+/// emissiveFactor x KHR_materials_emissive_strength, doubleSided; KHR_materials_unlit selects
+/// ShadingModel::Unlit. The base colour factor goes into the colour selection, as unlit.
 Material convert_material(const tinygltf::Material& source) {
   Material m;
   m.model =
@@ -154,10 +149,6 @@ Material convert_material(const tinygltf::Material& source) {
     }
   }
   m.double_sided = source.doubleSided;
-  // emissiveFactor scales the emissive texture (3.9.4); without textures a factor of 1 would
-  // turn the whole surface into a lamp (DamagedHelmet), so the emission is left out and
-  // counted (LoadedMesh::lit_warnings).
-  if (source.emissiveTexture.index >= 0) m.emissive_linear = glm::vec3(0.0f);
   return m;
 }
 
@@ -191,14 +182,16 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
   return normals;
 }
 
-/// The file as tinygltf reads it (images accepted without decoding); its message on failure.
+/// The file as tinygltf reads it (images kept as bytes, keep_image_bytes; decoded later by
+/// covrast's decoder, never by stb_image); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                            const std::filesystem::path& base_dir) {
   const std::optional<std::string> rewritten = without_draco_indices(bytes);
   if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
-  loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetImageLoader(&keep_image_bytes, nullptr);
+  loader.SetFsCallbacks(regular_file_callbacks());
   tinygltf::Model model;
   std::string err;
   std::string warn;
@@ -216,9 +209,9 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 5> kImplementedExtensions = {
-    kDracoExtension, "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
-    "KHR_materials_unlit", "KHR_mesh_quantization"};
+constexpr std::array<std::string_view, 6> kImplementedExtensions = {
+    kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
+    "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform"};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -264,6 +257,12 @@ struct PrimitiveSource {
   std::optional<DracoPrimitive> draco;
 };
 
+/// A primitive's UV sets and tangents as the file gives them (empty: absent).
+struct TextureAttributes {
+  std::vector<double> uv[kMaxTexcoordSets];
+  std::vector<double> tangents;
+};
+
 /// How one node's mesh reaches the file's world space, and its morph weights.
 struct Placement {
   std::vector<glm::dmat4> worlds;       ///< one copy per matrix (instances); unskinned only
@@ -276,13 +275,16 @@ struct Placement {
 /// colours and one uniform colour (LoadedMesh::has_uniform_color) at the end.
 class GltfMeshBuilder {
  public:
-  GltfMeshBuilder(const tinygltf::Model& model, const std::string& name)
+  GltfMeshBuilder(const tinygltf::Model& model, const std::string& name,
+                  const std::filesystem::path& base_dir)
       : model_(model), name_(name), reader_{model, name}, mesh_(std::make_shared<MeshData>()) {
     mesh_->source = name;
-    // The file's materials, then glTF's default material for primitives without one.
-    for (const tinygltf::Material& material : model.materials) {
-      mesh_->materials.push_back(convert_material(material));
-      if (material.emissiveTexture.index >= 0) ++emissive_textures_;
+    // The file's materials with their textures (each image decoded once), then glTF's default
+    // material for primitives without one.
+    GltfTextures textures(model, reader_, base_dir);
+    for (std::size_t i = 0; i < model.materials.size(); ++i) {
+      mesh_->materials.push_back(convert_material(model.materials[i]));
+      textures.apply(model.materials[i], int(i), mesh_->materials.back());
     }
     mesh_->materials.push_back(convert_material(tinygltf::Material{}));
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
@@ -305,10 +307,10 @@ class GltfMeshBuilder {
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
-    if (emissive_textures_ > 0) {
-      loaded.lit_warnings.push_back(name_ + ": " + std::to_string(emissive_textures_) +
-                                    " materials with an emissive texture: textures are not "
-                                    "rendered yet, their emission is left out");
+    if (missing_texcoords_ > 0) {
+      loaded.warnings.push_back(name_ + ": " + std::to_string(missing_texcoords_) +
+                                " primitives lack the TEXCOORD_n their material's textures use; "
+                                "UV (0, 0) used there");
     }
     if (any_color_attribute_ || factors_differ_) {
       // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
@@ -366,18 +368,22 @@ class GltfMeshBuilder {
     const std::vector<std::uint32_t> corners = triangle_corners(
         mode, vertex_sequence(source, what, vertex_count), primitive.indices >= 0, what);
     const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count);
+    const TextureAttributes texture_attributes =
+        read_texture_attributes(source, what, vertex_count);
     const std::uint32_t material = primitive.material >= 0
                                        ? static_cast<std::uint32_t>(primitive.material)
                                        : default_material_;
+    count_missing_texcoords(texture_attributes, material);
     if (placement.skin_joints.empty()) {
       for (const glm::dmat4& world : placement.worlds) {
-        place(vertices, corners, colors, material, world);
+        place(vertices, corners, colors, material, world, texture_attributes);
       }
     } else {
       const std::vector<glm::dmat4> skin =
           vertex_skin_matrices(skin_influences(source, vertices.count(), what), vertices.count(),
                                placement.skin_joints, name_, what);
-      place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0));
+      place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0),
+            texture_attributes);
     }
   }
 
@@ -441,8 +447,8 @@ class GltfMeshBuilder {
   /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
   /// triangles (turned when `world` mirrors), their material and their normals.
   void place(const PrimitiveVertices& vertices, const std::vector<std::uint32_t>& corners,
-             const std::vector<glm::vec3>& colors, std::uint32_t material,
-             const glm::dmat4& world) {
+             const std::vector<glm::vec3>& colors, std::uint32_t material, const glm::dmat4& world,
+             const TextureAttributes& texture_attributes) {
     const std::size_t base = mesh_->positions.size();
     const std::vector<double>& positions = vertices.positions;
     for (std::size_t v = 0; v < vertices.count(); ++v) {
@@ -465,6 +471,79 @@ class GltfMeshBuilder {
     add_corner_normals(vertices.normals.empty() ? std::vector<glm::vec3>{}
                                                 : world_normals(vertices.normals, world),
                        base, first_index);
+    add_corner_texture_attributes(texture_attributes, world, base, first_index);
+  }
+
+  /// Counts a primitive whose material samples a UV set the primitive does not have.
+  void count_missing_texcoords(const TextureAttributes& attributes, std::uint32_t material) {
+    const Material& m = mesh_->materials[material];
+    for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                    &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+      if (slot->texture && attributes.uv[slot->texcoord].empty()) {
+        ++missing_texcoords_;
+        return;
+      }
+    }
+  }
+
+  /// TEXCOORD_0 and _1 (VEC2 of float, or of normalized unsigned byte or short, or any type
+  /// KHR_mesh_quantization allows: the accessor reader maps each to numbers) and TANGENT
+  /// (VEC4), each empty when absent.
+  TextureAttributes read_texture_attributes(const PrimitiveSource& source, const std::string& what,
+                                            std::size_t vertex_count) const {
+    TextureAttributes out;
+    int components = 0;
+    for (int set = 0; set < kMaxTexcoordSets; ++set) {
+      std::string attribute = "TEXCOORD_";
+      attribute += char('0' + set);
+      auto values = attribute_values(source, attribute, what, components);
+      if (!values) continue;
+      if (components != 2 || values->size() != 2 * vertex_count) {
+        fail(name_, what + ": " + attribute + " must be VEC2 with one value per vertex");
+      }
+      out.uv[set] = std::move(*values);
+    }
+    auto tangents = attribute_values(source, "TANGENT", what, components);
+    if (tangents) {
+      if (components != 4 || tangents->size() != 4 * vertex_count) {
+        fail(name_, what + ": TANGENT must be VEC4 with one value per vertex");
+      }
+      out.tangents = std::move(*tangents);
+    }
+    return out;
+  }
+
+  /// Corner UVs and tangents of the indices from `first_index` on (like add_corner_normals:
+  /// a set starts at the first primitive that has it, earlier corners get zeros). Tangents
+  /// move with `world`'s 3x3 part as vectors, and their sign turns when it mirrors.
+  void add_corner_texture_attributes(const TextureAttributes& attributes, const glm::dmat4& world,
+                                     std::size_t base, std::size_t first_index) {
+    for (int set = 0; set < kMaxTexcoordSets; ++set) {
+      std::vector<glm::vec2>& out = mesh_->corner_texcoords[set];
+      const std::vector<double>& uv = attributes.uv[set];
+      if (uv.empty() && out.empty()) continue;
+      out.resize(first_index, glm::vec2(0.0f));
+      for (std::size_t i = first_index; i < mesh_->indices.size(); ++i) {
+        const std::size_t v = mesh_->indices[i] - base;
+        out.push_back(uv.empty() ? glm::vec2(0.0f)
+                                 : glm::vec2(float(uv[2 * v]), float(uv[2 * v + 1])));
+      }
+    }
+    const std::vector<double>& t = attributes.tangents;
+    if (t.empty() && mesh_->corner_tangents.empty()) return;
+    mesh_->corner_tangents.resize(first_index, glm::vec4(0.0f));
+    const glm::dmat3 linear(world);
+    const double sign = glm::determinant(linear) < 0.0 ? -1.0 : 1.0;
+    for (std::size_t i = first_index; i < mesh_->indices.size(); ++i) {
+      const std::size_t v = mesh_->indices[i] - base;
+      if (t.empty()) {
+        mesh_->corner_tangents.emplace_back(0.0f);
+        continue;
+      }
+      const glm::dvec3 tw = linear * glm::dvec3(t[4 * v], t[4 * v + 1], t[4 * v + 2]);
+      mesh_->corner_tangents.emplace_back(glm::vec3(tw),
+                                          float((t[4 * v + 3] < 0.0 ? -1.0 : 1.0) * sign));
+    }
   }
 
   /// The primitive's Draco stream decoded, when it has the extension (gltf_draco.hpp).
@@ -747,8 +826,8 @@ class GltfMeshBuilder {
   const GltfReader reader_;
   std::shared_ptr<MeshData> mesh_;
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
-  std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
+  std::size_t missing_texcoords_ = 0;  ///< primitives sampling a UV set they lack
   std::vector<FileCamera> cameras_;
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
   std::vector<bool> reached_;           ///< per node: in the walked scene
@@ -769,7 +848,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   const tinygltf::Model model = read_model(bytes, display_name, base_dir);
   check_required_extensions(model, display_name);
   const std::vector<int> roots = root_nodes(model, display_name);
-  GltfMeshBuilder builder(model, display_name);
+  GltfMeshBuilder builder(model, display_name, base_dir);
   builder.add_node_trees(roots);
   return builder.finish();
 }

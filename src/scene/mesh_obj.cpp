@@ -1,12 +1,15 @@
 // Wavefront OBJ reader for the subset covrast renders: "v x y z [r g b]", "vn x y z" and "f"
 // with any index form (i, i/t, i//n, i/t/n; negative = relative to the vertices or normals
 // defined so far). Polygons become the fan (0, k, k + 1), k = 1 .. n - 2, triangles in file
-// order; normals become corner normals (MeshData::corner_normals). Everything else (vt, o, g,
-// s, usemtl, mtllib, l, ...) is ignored, so a missing .mtl file never matters.
+// order; normals become corner normals (MeshData::corner_normals), "vt u [v [w]]" corner UVs
+// (MeshData::corner_texcoords[0], v flipped to glTF's convention: OBJ's v = 0 is the bottom
+// of the image). Everything else (o, g, s, usemtl, mtllib, l, ...) is ignored, so a missing
+// .mtl file never matters.
 #include "scene/scene_internal.hpp"
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
@@ -111,6 +114,47 @@ long long corner_normal(std::string_view token, std::size_t normal_count, const 
   return index < 0 && resolved >= 0 ? resolved : -1;
 }
 
+/// The texture-coordinate index of a face corner "i/t" or "i/t/n", 1-based (negative =
+/// relative to the vt lines read so far), resolved like corner_normal; kNoNormal when the
+/// corner gives none ("i" or "i//n").
+long long corner_texcoord(std::string_view token, std::size_t texcoord_count,
+                          const std::string& name, std::size_t line) {
+  const std::size_t first = token.find('/');
+  if (first == std::string_view::npos) return kNoNormal;
+  const std::size_t second = token.find('/', first + 1);
+  const std::string_view text = token.substr(
+      first + 1, second == std::string_view::npos ? std::string_view::npos : second - first - 1);
+  if (text.empty()) return kNoNormal;
+  long long index = 0;
+  if (!parse_integer(text, index)) fail(name, line, "bad face vertex '" + printable(token) + "'");
+  if (index > 0) return index - 1;
+  const long long resolved = static_cast<long long>(texcoord_count) + index;
+  return index < 0 && resolved >= 0 ? resolved : -1;
+}
+
+/// Corner UVs from the resolved indices (zero where a corner has none); references to vt
+/// lines that do not exist are counted in a warning.
+void resolve_corner_texcoords(const std::vector<long long>& refs,
+                              const std::vector<glm::vec2>& texcoords, const std::string& name,
+                              LoadedMesh& loaded) {
+  std::size_t missing = 0;
+  std::vector<glm::vec2>& out = loaded.data->corner_texcoords[0];
+  out.assign(refs.size(), glm::vec2(0.0f));
+  for (std::size_t c = 0; c < refs.size(); ++c) {
+    if (refs[c] == kNoNormal) continue;
+    if (refs[c] >= 0 && static_cast<std::size_t>(refs[c]) < texcoords.size()) {
+      out[c] = texcoords[static_cast<std::size_t>(refs[c])];
+    } else {
+      ++missing;
+    }
+  }
+  if (missing > 0) {
+    loaded.warnings.push_back(name + ": " + std::to_string(missing) +
+                              " face corners reference texture coordinates that do not exist (" +
+                              std::to_string(texcoords.size()) + " vt lines); (0, 0) used");
+  }
+}
+
 /// Corner normals from the resolved indices; a reference to a normal that does not exist
 /// gives no normal there (that face uses its face normal), counted in a warning.
 void resolve_corner_normals(const std::vector<long long>& refs,
@@ -153,6 +197,8 @@ class ObjParser {
       read_vertex(tokens, line_no);
     } else if (keyword == "vn") {
       read_normal(tokens, line_no);
+    } else if (keyword == "vt") {
+      read_texcoord(tokens, line_no);
     } else if (keyword == "f") {
       read_face(tokens, line_no);
     }
@@ -174,6 +220,7 @@ class ObjParser {
     LoadedMesh loaded;
     loaded.data = mesh_;
     if (any_face_normal_) resolve_corner_normals(normal_refs_, normals_, name_, loaded);
+    if (any_face_uv_) resolve_corner_texcoords(uv_refs_, texcoords_, name_, loaded);
     loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh_);
     analyze_mesh_topology(*mesh_);  // once per file: instances share the result
     loaded.data = std::move(mesh_);
@@ -221,14 +268,34 @@ class ObjParser {
                           static_cast<float>(values[2]));
   }
 
+  /// "vt u [v [w]]": stored as (u, 1 - v), glTF's orientation; w is ignored.
+  void read_texcoord(Tokens& tokens, std::size_t line_no) {
+    double values[2] = {0.0, 0.0};
+    int count = 0;
+    std::string_view token;
+    while (tokens.next(token)) {
+      if (count < 2 && !parse_double(token, values[count])) {
+        fail(name_, line_no, "bad number '" + printable(token) + "'");
+      }
+      ++count;
+    }
+    if (count < 1 || count > 3) fail(name_, line_no, "texture coordinate needs u [v [w]]");
+    if (!std::isfinite(values[0]) || !std::isfinite(values[1])) {
+      fail(name_, line_no, "texture coordinate must be finite");
+    }
+    texcoords_.emplace_back(static_cast<float>(values[0]), static_cast<float>(1.0 - values[1]));
+  }
+
   /// "f" and its corners; the polygon becomes the fan (0, k, k + 1).
   void read_face(Tokens& tokens, std::size_t line_no) {
     corners_.clear();
     corner_normals_.clear();
+    corner_uvs_.clear();
     std::string_view token;
     while (tokens.next(token)) {
       corners_.push_back(corner_vertex(token, line_no));
       corner_normals_.push_back(corner_normal(token, normals_.size(), name_, line_no));
+      corner_uvs_.push_back(corner_texcoord(token, texcoords_.size(), name_, line_no));
     }
     if (corners_.size() < 3) {
       fail(name_, line_no,
@@ -241,10 +308,17 @@ class ObjParser {
       normal_refs_.assign(mesh_->indices.size(), kNoNormal);
       any_face_normal_ = true;
     }
+    const bool face_uvs = std::any_of(corner_uvs_.begin(), corner_uvs_.end(),
+                                      [](long long t) { return t != kNoNormal; });
+    if (face_uvs && !any_face_uv_) {
+      uv_refs_.assign(mesh_->indices.size(), kNoNormal);
+      any_face_uv_ = true;
+    }
     for (std::size_t k = 1; k + 1 < corners_.size(); ++k) {
       for (const std::size_t c : {std::size_t(0), k, k + 1}) {
         mesh_->indices.push_back(corners_[c]);
         if (any_face_normal_) normal_refs_.push_back(corner_normals_[c]);
+        if (any_face_uv_) uv_refs_.push_back(corner_uvs_[c]);
       }
     }
   }
@@ -284,6 +358,10 @@ class ObjParser {
   std::vector<long long> corner_normals_;  ///< of the current face: see corner_normal()
   std::vector<long long> normal_refs_;     ///< per triangle corner, as corner_normals_
   bool any_face_normal_ = false;
+  std::vector<glm::vec2> texcoords_;   ///< vt lines, in file order, v flipped
+  std::vector<long long> corner_uvs_;  ///< of the current face: see corner_texcoord()
+  std::vector<long long> uv_refs_;     ///< per triangle corner, as corner_uvs_
+  bool any_face_uv_ = false;
   /// Positive indices may point past the vertices read so far (OBJ does not forbid forward
   /// references); the largest one is checked against the final count at the end.
   long long max_forward_index_ = 0;

@@ -49,6 +49,14 @@ void check_material(const Material& m, const std::string& what) {
   }
   if (!non_negative(m.emissive_linear)) fail(what, "emissive must be finite and >= 0");
   if (!non_negative(m.specular_linear)) fail(what, "specular must be finite and >= 0");
+  for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
+                                  &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+    if (slot->texcoord < 0 || slot->texcoord >= kMaxTexcoordSets) {
+      fail(what, "a texture's texcoord must be 0 or 1");
+    }
+    if (slot->texture && slot->texture->levels.empty()) fail(what, "a texture has no texels");
+    if (!std::isfinite(slot->scale)) fail(what, "a texture's scale must be finite");
+  }
 }
 
 /// Finite, with the last row (0, 0, 0, 1): model[col][row] in GLM.
@@ -106,6 +114,17 @@ void check_mesh_arrays(const MeshData& mesh, const std::string& what) {
     fail(what, std::to_string(mesh.corner_normals.size()) + " corner normals for " +
                    std::to_string(mesh.indices.size()) + " indices (3 per triangle)");
   }
+  for (int set = 0; set < kMaxTexcoordSets; ++set) {
+    const std::size_t uvs = mesh.corner_texcoords[set].size();
+    if (uvs != 0 && uvs != mesh.indices.size()) {
+      fail(what, std::to_string(uvs) + " corner UVs of set " + std::to_string(set) + " for " +
+                     std::to_string(mesh.indices.size()) + " indices (3 per triangle)");
+    }
+  }
+  if (!mesh.corner_tangents.empty() && mesh.corner_tangents.size() != mesh.indices.size()) {
+    fail(what, std::to_string(mesh.corner_tangents.size()) + " corner tangents for " +
+                   std::to_string(mesh.indices.size()) + " indices (3 per triangle)");
+  }
   if (!mesh.triangle_materials.empty()) {
     if (mesh.triangle_materials.size() != mesh.triangle_count()) {
       fail(what, std::to_string(mesh.triangle_materials.size()) + " triangle materials for " +
@@ -150,12 +169,21 @@ std::shared_ptr<const MeshData> make_mesh(MeshArrays arrays) {
       fail(name, "corner_normals[" + std::to_string(i) + "] is not finite");
     }
   }
+  for (const std::vector<glm::vec2>* uvs : {&arrays.corner_texcoords, &arrays.corner_texcoords1}) {
+    for (std::size_t i = 0; i < uvs->size(); ++i) {
+      if (!std::isfinite((*uvs)[i].x) || !std::isfinite((*uvs)[i].y)) {
+        fail(name, "corner_texcoords[" + std::to_string(i) + "] is not finite");
+      }
+    }
+  }
   for (std::size_t m = 0; m < arrays.materials.size(); ++m) {
     check_material(arrays.materials[m], name + ": materials[" + std::to_string(m) + "]");
   }
   mesh->positions = std::move(arrays.positions);
   mesh->indices = std::move(arrays.indices);
   mesh->corner_normals = std::move(arrays.corner_normals);
+  mesh->corner_texcoords[0] = std::move(arrays.corner_texcoords);
+  mesh->corner_texcoords[1] = std::move(arrays.corner_texcoords1);
   mesh->materials = std::move(arrays.materials);
   mesh->triangle_materials = std::move(arrays.triangle_materials);
   check_mesh_arrays(*mesh, name);

@@ -56,6 +56,14 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name);
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                       const std::filesystem::path& base_dir);
 
+/// An image file as a texture (docs/textures.md): read_image, then make_texture with `srgb`
+/// (true for colour maps: glTF baseColor and emissive, OBJ map_Kd). `name` names it in
+/// messages, e.g. "model.obj: map_Kd wood.png". Throws InputError when it is missing or
+/// cannot be decoded. The hook for OBJ materials: each distinct map_Kd path of a file loaded
+/// once, its Texture shared by the materials that name it.
+std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
+                                                 const std::string& name, bool srgb);
+
 /// Removes every triangle that uses a vertex with a non-finite coordinate and sets such
 /// vertices to the origin (nothing references them any more). Returns the number removed.
 std::size_t drop_nonfinite_triangles(MeshData& mesh);

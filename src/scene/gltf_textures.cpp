@@ -1,0 +1,203 @@
+// glTF textures (see gltf_textures.hpp; formulas and conventions in docs/textures.md).
+#include "scene/gltf_textures.hpp"
+#include "scene/scene_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string_view>
+
+namespace covrast::detail {
+
+bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                      const unsigned char* bytes, int size, void*) {
+  if (image->bufferView >= 0) return true;  // read from the view, bounds-checked (decode())
+  image->image.assign(bytes, bytes + size);
+  image->as_is = true;
+  return true;
+}
+
+namespace {
+
+bool read_regular_file(std::vector<unsigned char>* out, std::string* error, const std::string& path,
+                       void* user_data) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    if (error != nullptr) *error += path + ": not a regular file\n";
+    return false;
+  }
+  return tinygltf::ReadWholeFile(out, error, path, user_data);
+}
+
+/// A URI's %XX escapes decoded (RFC 3986, 2.1), as tinygltf decodes it before opening.
+std::string percent_decoded(const std::string& uri) {
+  std::string out;
+  for (std::size_t i = 0; i < uri.size(); ++i) {
+    const auto hex = [](char c) {
+      return c >= '0' && c <= '9'   ? c - '0'
+             : c >= 'a' && c <= 'f' ? c - 'a' + 10
+             : c >= 'A' && c <= 'F' ? c - 'A' + 10
+                                    : -1;
+    };
+    if (uri[i] == '%' && i + 2 < uri.size() && hex(uri[i + 1]) >= 0 && hex(uri[i + 2]) >= 0) {
+      out += char(hex(uri[i + 1]) * 16 + hex(uri[i + 2]));
+      i += 2;
+    } else {
+      out += uri[i];
+    }
+  }
+  return out;
+}
+
+/// glTF 2.0, 5.26 (sampler): wrap codes 33071, 33648, 10497; filters 9728 NEAREST, 9729
+/// LINEAR, 9984..9987 the mipmapped minifications. Undefined filters keep the defaults.
+TextureWrap wrap_mode(int code) {
+  if (code == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE) return TextureWrap::ClampToEdge;
+  if (code == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT) return TextureWrap::MirroredRepeat;
+  return TextureWrap::Repeat;
+}
+
+TextureSampler sampler_of(const tinygltf::Sampler& s) {
+  TextureSampler out;
+  out.wrap_s = wrap_mode(s.wrapS);
+  out.wrap_t = wrap_mode(s.wrapT);
+  if (s.magFilter == TINYGLTF_TEXTURE_FILTER_NEAREST) out.mag = TextureFilter::Nearest;
+  switch (s.minFilter) {
+    case TINYGLTF_TEXTURE_FILTER_NEAREST:
+      out.min = TextureFilter::Nearest;
+      out.mip = MipFilter::None;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR:
+      out.mip = MipFilter::None;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST:
+      out.min = TextureFilter::Nearest;
+      out.mip = MipFilter::Nearest;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_NEAREST:
+      out.mip = MipFilter::Nearest;
+      break;
+    case TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_LINEAR:
+      out.min = TextureFilter::Nearest;
+      break;
+    default:  // LINEAR_MIPMAP_LINEAR, or none given
+      break;
+  }
+  return out;
+}
+
+double number_or(const tinygltf::Value& object, const char* key, double fallback) {
+  if (!object.Has(key) || !object.Get(key).IsNumber()) return fallback;
+  const double v = object.Get(key).GetNumberAsDouble();
+  return std::isfinite(v) ? v : fallback;
+}
+
+glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fallback) {
+  if (!object.Has(key)) return fallback;
+  const tinygltf::Value& a = object.Get(key);
+  if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
+    return fallback;
+  }
+  const glm::dvec2 v(a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble());
+  return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
+}
+
+}  // namespace
+
+std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
+                                                 const std::string& name, bool srgb) {
+  const RgbaImage image = read_image(path, name);
+  return make_texture(name, image.width, image.height, image.rgba, srgb);
+}
+
+tinygltf::FsCallbacks regular_file_callbacks() {
+  return tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_regular_file,
+                               &tinygltf::WriteWholeFile, nullptr};
+}
+
+RgbaImage GltfTextures::decode(const tinygltf::Image& image, const std::string& image_name) const {
+  if (image.bufferView >= 0) {
+    const unsigned char* bytes = reader_.view_bytes(image_name, image.bufferView);
+    const std::size_t size = model_.bufferViews[std::size_t(image.bufferView)].byteLength;
+    return decode_image(bytes, size, image_name);
+  }
+  if (!image.image.empty()) return decode_image(image.image.data(), image.image.size(), image_name);
+  // tinygltf could not read the file (it only warns): read it here for the reason.
+  if (image.uri.empty()) throw InputError(image_name + ": no image data");
+  return read_image(base_dir_ / percent_decoded(image.uri), image_name);
+}
+
+std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool srgb,
+                                                           const std::string& what) {
+  if (image_index < 0 || std::size_t(image_index) >= model_.images.size()) {
+    fail(reader_.name, what + ": image " + std::to_string(image_index) + " does not exist");
+  }
+  const auto key = std::make_pair(image_index, srgb);
+  if (const auto it = textures_.find(key); it != textures_.end()) return it->second;
+  const tinygltf::Image& image = model_.images[std::size_t(image_index)];
+  std::string image_name = reader_.name + ": image " + std::to_string(image_index);
+  if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0) {
+    image_name += " (" + printable(image.uri) + ")";
+  } else if (!image.name.empty()) {
+    image_name += " (" + printable(image.name) + ")";
+  }
+  const RgbaImage rgba = decode(image, image_name);
+  auto texture = make_texture(image_name, rgba.width, rgba.height, rgba.rgba, srgb);
+  textures_.emplace(key, texture);
+  return texture;
+}
+
+TextureSlot GltfTextures::slot(int texture_index, int texcoord,
+                               const tinygltf::ExtensionMap& extensions, bool srgb,
+                               const std::string& what) {
+  TextureSlot out;
+  if (texture_index < 0) return out;
+  if (std::size_t(texture_index) >= model_.textures.size()) {
+    fail(reader_.name, what + ": texture " + std::to_string(texture_index) + " does not exist");
+  }
+  const tinygltf::Texture& texture = model_.textures[std::size_t(texture_index)];
+  if (texture.sampler >= 0) {
+    if (std::size_t(texture.sampler) >= model_.samplers.size()) {
+      fail(reader_.name, what + ": sampler " + std::to_string(texture.sampler) + " does not exist");
+    }
+    out.sampler = sampler_of(model_.samplers[std::size_t(texture.sampler)]);
+  }
+  out.texcoord = texcoord;
+  // KHR_texture_transform on the textureInfo: offset, rotation, scale, texCoord override.
+  if (const auto it = extensions.find("KHR_texture_transform");
+      it != extensions.end() && it->second.IsObject()) {
+    const tinygltf::Value& t = it->second;
+    out.transform.offset = pair_or(t, "offset", glm::dvec2(0.0));
+    out.transform.rotation = number_or(t, "rotation", 0.0);
+    out.transform.scale = pair_or(t, "scale", glm::dvec2(1.0));
+    out.texcoord = int(number_or(t, "texCoord", double(texcoord)));
+  }
+  if (out.texcoord < 0 || out.texcoord >= kMaxTexcoordSets) {
+    fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) +
+                           " (covrast reads TEXCOORD_0 and TEXCOORD_1)");
+  }
+  out.texture = image_texture(texture.source, srgb, what);
+  return out;
+}
+
+void GltfTextures::apply(const tinygltf::Material& source, int material_index, Material& m) {
+  const std::string what = "material " + std::to_string(material_index);
+  const tinygltf::PbrMetallicRoughness& pbr = source.pbrMetallicRoughness;
+  m.base_color_texture = slot(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                              pbr.baseColorTexture.extensions, true, what + " baseColorTexture");
+  m.metallic_roughness_texture =
+      slot(pbr.metallicRoughnessTexture.index, pbr.metallicRoughnessTexture.texCoord,
+           pbr.metallicRoughnessTexture.extensions, false, what + " metallicRoughnessTexture");
+  m.normal_texture = slot(source.normalTexture.index, source.normalTexture.texCoord,
+                          source.normalTexture.extensions, false, what + " normalTexture");
+  m.normal_texture.scale =
+      float(std::isfinite(source.normalTexture.scale) ? source.normalTexture.scale : 1.0);
+  m.occlusion_texture = slot(source.occlusionTexture.index, source.occlusionTexture.texCoord,
+                             source.occlusionTexture.extensions, false, what + " occlusionTexture");
+  const double strength = source.occlusionTexture.strength;
+  m.occlusion_texture.scale = float(std::isfinite(strength) ? std::clamp(strength, 0.0, 1.0) : 1.0);
+  m.emissive_texture = slot(source.emissiveTexture.index, source.emissiveTexture.texCoord,
+                            source.emissiveTexture.extensions, true, what + " emissiveTexture");
+}
+
+}  // namespace covrast::detail

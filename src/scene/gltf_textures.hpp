@@ -1,0 +1,55 @@
+// glTF textures for the glTF loader (mesh_gltf.cpp): images decoded by covrast's own decoder
+// (image_io.cpp: libspng, libturbojpeg), never by tinygltf's stb_image, samplers, and the
+// material slots with texCoord and KHR_texture_transform (docs/textures.md).
+#pragma once
+
+#include "scene/gltf_accessors.hpp"
+
+#include <covrast/image.hpp>
+#include <covrast/scene.hpp>
+
+#include <tiny_gltf.h>
+
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <string>
+#include <utility>
+
+namespace covrast::detail {
+
+/// tinygltf's image callback (TinyGLTF::SetImageLoader): keeps the raw bytes of an image from
+/// a file or a data: URI in Image::image (as_is) without decoding them; images in a buffer
+/// view are read later, bounds-checked, from the view.
+bool keep_image_bytes(tinygltf::Image* image, const int image_index, std::string* error,
+                      std::string* warning, int, int, const unsigned char* bytes, int size, void*);
+
+/// tinygltf's file callbacks with one change: only regular files are read (a FIFO named as a
+/// buffer or image would block the loader forever).
+tinygltf::FsCallbacks regular_file_callbacks();
+
+/// The textures of one glTF file: each image decoded and mipmapped at most once per colour
+/// space, shared by every material slot that uses it.
+class GltfTextures {
+ public:
+  GltfTextures(const tinygltf::Model& model, const GltfReader& reader,
+               std::filesystem::path base_dir)
+      : model_(model), reader_(reader), base_dir_(std::move(base_dir)) {}
+
+  /// Fills the texture slots of `material` from `source`. Throws InputError naming the file
+  /// and the image when an image is missing or cannot be decoded.
+  void apply(const tinygltf::Material& source, int material_index, Material& material);
+
+ private:
+  TextureSlot slot(int texture_index, int texcoord, const tinygltf::ExtensionMap& extensions,
+                   bool srgb, const std::string& what);
+  std::shared_ptr<const Texture> image_texture(int image_index, bool srgb, const std::string& what);
+  RgbaImage decode(const tinygltf::Image& image, const std::string& image_name) const;
+
+  const tinygltf::Model& model_;
+  const GltfReader& reader_;
+  std::filesystem::path base_dir_;
+  std::map<std::pair<int, bool>, std::shared_ptr<const Texture>> textures_;
+};
+
+}  // namespace covrast::detail

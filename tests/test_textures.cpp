@@ -1,0 +1,711 @@
+// Tests of textures (docs/textures.md): exact texel reproduction, mip levels and bilinear
+// magnification in linear light, wrap modes and KHR_texture_transform against an analytic
+// texel lookup, the exact UV derivatives and the level of detail on a tilted plane, the same
+// bytes for every thread count and tile size, decoding PNG and JPEG (by content), and bad
+// images as InputErrors naming the image and the model. Every image is generated here.
+#include <covrast/error.hpp>
+#include <covrast/image.hpp>
+#include <covrast/renderer.hpp>
+#include <covrast/scene.hpp>
+
+#include "core/shading_inputs.hpp"
+#include "core/texture_sampling.hpp"
+#include "scene/scene_internal.hpp"
+
+#include <turbojpeg.h>
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "test_gltf_files.hpp"
+#include "test_tempdir.hpp"
+
+using Catch::Matchers::Contains;
+
+namespace {
+
+double srgb_decode(int code) {
+  const double c = code / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+double srgb_encode_255(double linear) {
+  const double l = std::clamp(linear, 0.0, 1.0);
+  return 255.0 * (l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055);
+}
+
+/// Deterministic texels: 8-bit RGBA, alpha 255.
+std::vector<std::uint8_t> random_rgba(int width, int height, std::uint32_t seed) {
+  std::vector<std::uint8_t> rgba(std::size_t(width) * height * 4);
+  for (std::size_t i = 0; i < rgba.size(); ++i) {
+    seed = seed * 1664525u + 1013904223u;
+    rgba[i] = (i % 4 == 3) ? 255 : std::uint8_t(seed >> 24);
+  }
+  return rgba;
+}
+
+/// The quad [-1, 1]^2 at z = 0 seen from (0, 0, 1) with a 90 degree field of view in a
+/// square image: it fills the image exactly; UV (0, 0) at the top-left corner, (1, 1) at the
+/// bottom-right, scaled to [uv0, uv1].
+covrast::Scene quad_scene(int size, const covrast::TextureSlot& slot, float uv0 = 0.0f,
+                          float uv1 = 1.0f) {
+  covrast::Scene scene;
+  scene.width = size;
+  scene.height = size;
+  scene.camera.eye = {0.0, 0.0, 1.0};
+  scene.camera.fovy_deg = 90.0;
+  scene.camera.near = 0.5;
+  scene.camera.far = 10.0;
+  covrast::MeshArrays quad{.name = "quad",
+                           .positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}},
+                           .indices = {0, 1, 2, 0, 2, 3}};
+  const glm::vec2 uv[4] = {{uv0, uv1}, {uv1, uv1}, {uv1, uv0}, {uv0, uv0}};
+  for (const std::uint32_t i : quad.indices) quad.corner_texcoords.push_back(uv[i]);
+  covrast::Material material;
+  material.base_color_texture = slot;
+  covrast::add_instance(scene, covrast::make_mesh(quad), {.material = material});
+  return scene;
+}
+
+covrast::TextureSlot slot_of(std::shared_ptr<const covrast::Texture> texture,
+                             covrast::TextureFilter mag, covrast::TextureFilter min,
+                             covrast::MipFilter mip) {
+  covrast::TextureSlot slot;
+  slot.texture = std::move(texture);
+  slot.sampler.mag = mag;
+  slot.sampler.min = min;
+  slot.sampler.mip = mip;
+  return slot;
+}
+
+covrast::Image render_mode(const covrast::Scene& scene, const char* mode, int threads = 2,
+                           int tile = 64) {
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode(mode);
+  options.threads = threads;
+  options.tile = tile;
+  return covrast::render(scene, options).color;
+}
+
+}  // namespace
+
+TEST_CASE("textures: a 64x64 texture on a 64x64 quad with NEAREST reproduces its bytes",
+          "[textures]") {
+  const auto rgba = random_rgba(64, 64, 7);
+  const auto texture = covrast::make_texture("noise", 64, 64, rgba, true);
+  const covrast::Scene scene =
+      quad_scene(64, slot_of(texture, covrast::TextureFilter::Nearest,
+                             covrast::TextureFilter::Nearest, covrast::MipFilter::None));
+  for (const char* mode : {"coverage", "aliased", "msaa:4"}) {
+    INFO(mode);
+    const covrast::Image image = render_mode(scene, mode);
+    int differing = 0;
+    for (int i = 0; i < 64 * 64; ++i) {
+      for (int c = 0; c < 3; ++c) differing += image.rgb[3 * i + c] != rgba[4 * i + c];
+    }
+    REQUIRE(differing == 0);
+  }
+}
+
+TEST_CASE("textures: mip level 1 is the 2x2 mean in linear light (LINEAR_MIPMAP_LINEAR at 32x32)",
+          "[textures]") {
+  const auto rgba = random_rgba(64, 64, 11);
+  const auto texture = covrast::make_texture("noise", 64, 64, rgba, true);
+  REQUIRE(texture->levels.size() == 7);
+  const covrast::Scene scene =
+      quad_scene(32, slot_of(texture, covrast::TextureFilter::Linear,
+                             covrast::TextureFilter::Linear, covrast::MipFilter::Linear));
+  const covrast::Image image = render_mode(scene, "coverage");
+  double worst = 0.0;
+  for (int y = 0; y < 32; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        double mean = 0.0;
+        for (int dy = 0; dy < 2; ++dy) {
+          for (int dx = 0; dx < 2; ++dx) {
+            mean += srgb_decode(rgba[((2 * y + dy) * 64 + 2 * x + dx) * 4 + c]) / 4.0;
+          }
+        }
+        worst = std::max(worst, std::abs(image.pixel(x, y)[c] - srgb_encode_255(mean)));
+      }
+    }
+  }
+  REQUIRE(worst <= 1.0);
+}
+
+TEST_CASE("textures: LINEAR magnification at 128x128 is the bilinear blend in linear light",
+          "[textures]") {
+  const auto rgba = random_rgba(64, 64, 13);
+  const auto texture = covrast::make_texture("noise", 64, 64, rgba, true);
+  const covrast::Scene scene =
+      quad_scene(128, slot_of(texture, covrast::TextureFilter::Linear,
+                              covrast::TextureFilter::Linear, covrast::MipFilter::Linear));
+  const covrast::Image image = render_mode(scene, "coverage");
+  double worst = 0.0;
+  for (int y = 0; y < 128; ++y) {
+    for (int x = 0; x < 128; ++x) {
+      // Texel coordinates of the pixel centre: (x + 0.5) / 128 * 64 - 0.5 = x / 2 - 0.25.
+      const double tx = x / 2.0 - 0.25, ty = y / 2.0 - 0.25;
+      const int x0 = int(std::floor(tx)), y0 = int(std::floor(ty));
+      const double fx = tx - x0, fy = ty - y0;
+      for (int c = 0; c < 3; ++c) {
+        const auto texel = [&](int i, int j) {
+          return srgb_decode(rgba[(((j + 64) % 64) * 64 + (i + 64) % 64) * 4 + c]);
+        };
+        const double value = (texel(x0, y0) * (1 - fx) + texel(x0 + 1, y0) * fx) * (1 - fy) +
+                             (texel(x0, y0 + 1) * (1 - fx) + texel(x0 + 1, y0 + 1) * fx) * fy;
+        worst = std::max(worst, std::abs(image.pixel(x, y)[c] - srgb_encode_255(value)));
+      }
+    }
+  }
+  REQUIRE(worst <= 1.0);
+}
+
+TEST_CASE("textures: mip chain of odd sizes keeps every texel (3-texel boxes at the odd end)",
+          "[textures]") {
+  // 5x3: level 1 is 2x1, its texel 1 averages columns 2..4 and rows 0..2.
+  std::vector<std::uint8_t> rgba(5 * 3 * 4, 255);
+  for (int i = 0; i < 15; ++i) rgba[4 * i] = std::uint8_t(i * 17);
+  const auto texture = covrast::make_texture("odd", 5, 3, rgba, false);
+  REQUIRE(texture->levels.size() == 3);
+  REQUIRE(texture->levels[1].width == 2);
+  REQUIRE(texture->levels[1].height == 1);
+  double expected = 0.0;
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 2; x < 5; ++x) expected += (y * 5 + x) * 17 / 255.0 / 9.0;
+  }
+  REQUIRE(texture->levels[1].at(1, 0).r == Approx(expected).epsilon(1e-6));
+  // The last level's mean equals the whole image's for even sides.
+  const auto even = covrast::make_texture("even", 8, 4, random_rgba(8, 4, 3), false);
+  double mean = 0.0;
+  for (const glm::vec4& t : even->levels[0].texels) mean += t.g / 32.0;
+  REQUIRE(even->levels.back().texels[0].g == Approx(mean).epsilon(1e-6));
+}
+
+TEST_CASE("textures: wrap modes and KHR_texture_transform against an analytic texel lookup",
+          "[textures]") {
+  // 8x8 texels, each with its own colour (i, j and the checkerboard parity).
+  std::vector<std::uint8_t> rgba(8 * 8 * 4, 255);
+  for (int j = 0; j < 8; ++j) {
+    for (int i = 0; i < 8; ++i) {
+      std::uint8_t* t = &rgba[(j * 8 + i) * 4];
+      t[0] = std::uint8_t(i * 32);
+      t[1] = std::uint8_t(j * 32);
+      t[2] = (i + j) % 2 == 0 ? 0 : 255;
+    }
+  }
+  const auto texture = covrast::make_texture("checker", 8, 8, rgba, true);
+  using covrast::TextureWrap;
+  struct Case {
+    TextureWrap s, t;
+    covrast::TextureTransform transform;
+  };
+  const Case cases[] = {
+      {TextureWrap::Repeat, TextureWrap::MirroredRepeat, {}},
+      {TextureWrap::ClampToEdge, TextureWrap::Repeat, {}},
+      {TextureWrap::MirroredRepeat,
+       TextureWrap::ClampToEdge,
+       {glm::dvec2(0.25, -0.1), 0.3, glm::dvec2(1.5, 0.75)}},
+  };
+  for (const Case& c : cases) {
+    covrast::TextureSlot slot = slot_of(texture, covrast::TextureFilter::Nearest,
+                                        covrast::TextureFilter::Nearest, covrast::MipFilter::None);
+    slot.sampler.wrap_s = c.s;
+    slot.sampler.wrap_t = c.t;
+    slot.transform = c.transform;
+    const covrast::Scene scene = quad_scene(96, slot, -1.0f, 2.0f);
+    const covrast::Image image = render_mode(scene, "coverage");
+    int mismatches = 0, near_boundary = 0;
+    for (int y = 0; y < 96; ++y) {
+      for (int x = 0; x < 96; ++x) {
+        const double u = -1.0 + 3.0 * (x + 0.5) / 96.0, v = -1.0 + 3.0 * (y + 0.5) / 96.0;
+        // T R S: u' = cos r (su u) + sin r (sv v) + ou, v' = -sin r (su u) + cos r (sv v) + ov.
+        const double su = u * c.transform.scale.x, sv = v * c.transform.scale.y;
+        const double r = c.transform.rotation;
+        const double tu = (std::cos(r) * su + std::sin(r) * sv + c.transform.offset.x) * 8.0;
+        const double tv = (-std::sin(r) * su + std::cos(r) * sv + c.transform.offset.y) * 8.0;
+        const int i = covrast::detail::wrap_texel((long long)std::floor(tu), 8, c.s);
+        const int j = covrast::detail::wrap_texel((long long)std::floor(tv), 8, c.t);
+        const std::uint8_t* p = image.pixel(x, y);
+        if (p[0] != i * 32 || p[1] != j * 32) {
+          ++mismatches;
+          // Only where the exact coordinate is a hair from a texel boundary.
+          const double du = std::abs(tu - std::round(tu)), dv = std::abs(tv - std::round(tv));
+          if (std::min(du, dv) < 1e-4) ++near_boundary;
+        }
+      }
+    }
+    REQUIRE(mismatches == near_boundary);
+    REQUIRE(mismatches < 20);
+  }
+  // The wrap rules themselves.
+  REQUIRE(covrast::detail::wrap_texel(-1, 8, TextureWrap::Repeat) == 7);
+  REQUIRE(covrast::detail::wrap_texel(-1, 8, TextureWrap::MirroredRepeat) == 0);
+  REQUIRE(covrast::detail::wrap_texel(8, 8, TextureWrap::MirroredRepeat) == 7);
+  REQUIRE(covrast::detail::wrap_texel(17, 8, TextureWrap::MirroredRepeat) == 1);
+  REQUIRE(covrast::detail::wrap_texel(-5, 8, TextureWrap::ClampToEdge) == 0);
+  REQUIRE(covrast::detail::wrap_texel(99, 8, TextureWrap::ClampToEdge) == 7);
+}
+
+TEST_CASE("textures: the analytic derivatives of the perspective-correct weights", "[textures]") {
+  covrast::detail::TriangleSetup t{};
+  const double xs[3] = {10.25, 200.5, 40.0}, ys[3] = {20.0, 60.75, 180.5};
+  for (int k = 0; k < 3; ++k) {
+    t.x_fx8[k] = std::int32_t(xs[k] * 256);
+    t.y_fx8[k] = std::int32_t(ys[k] * 256);
+  }
+  t.inv_w[0] = 1.0f;
+  t.inv_w[1] = 0.25f;
+  t.inv_w[2] = 0.6f;
+  // mu(x, y) exactly as shade() computes it.
+  const auto mu = [&](double x, double y, double out[3]) {
+    const double area = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (xs[2] - xs[0]) * (ys[1] - ys[0]);
+    const double l[3] = {((xs[2] - xs[1]) * (y - ys[1]) - (ys[2] - ys[1]) * (x - xs[1])) / area,
+                         ((xs[0] - xs[2]) * (y - ys[2]) - (ys[0] - ys[2]) * (x - xs[2])) / area,
+                         ((xs[1] - xs[0]) * (y - ys[0]) - (ys[1] - ys[0]) * (x - xs[0])) / area};
+    double sum = 0.0;
+    for (int k = 0; k < 3; ++k) sum += l[k] * t.inv_w[k];
+    for (int k = 0; k < 3; ++k) out[k] = l[k] * t.inv_w[k] / sum;
+  };
+  for (const auto& point : {glm::dvec2(60.0, 70.0), glm::dvec2(100.3, 80.7), glm::dvec2(45, 150)}) {
+    double m[3], px[3], nx[3], py[3], ny[3];
+    mu(point.x, point.y, m);
+    const double h = 1e-3;
+    mu(point.x + h, point.y, px);
+    mu(point.x - h, point.y, nx);
+    mu(point.x, point.y + h, py);
+    mu(point.x, point.y - h, ny);
+    const covrast::detail::WeightDerivatives d =
+        covrast::detail::weight_derivatives(t, m[0], m[1], m[2]);
+    for (int k = 0; k < 3; ++k) {
+      REQUIRE(d.dx[k] == Approx((px[k] - nx[k]) / (2 * h)).margin(1e-9));
+      REQUIRE(d.dy[k] == Approx((py[k] - ny[k]) / (2 * h)).margin(1e-9));
+    }
+  }
+}
+
+namespace {
+
+/// A tilted floor y = -1, x in [-4, 4], z in [-40, 2], seen from (0, 0.5, 3) looking down
+/// the corridor; u = (x + 4) / 8 x 2, v = (2 - z) / 42 x 16.
+covrast::Scene floor_scene(const covrast::TextureSlot& slot, int width, int height) {
+  covrast::Scene scene;
+  scene.width = width;
+  scene.height = height;
+  scene.camera.eye = {0.0, 0.5, 3.0};
+  scene.camera.target = {0.0, -1.0, -6.0};
+  scene.camera.fovy_deg = 60.0;
+  scene.camera.near = 0.1;
+  scene.camera.far = 100.0;
+  covrast::MeshArrays floor{.name = "floor",
+                            .positions = {{-4, -1, 2}, {4, -1, 2}, {4, -1, -40}, {-4, -1, -40}},
+                            .indices = {0, 1, 2, 0, 2, 3}};
+  const glm::vec2 uv[4] = {{0, 0}, {2, 0}, {2, 16}, {0, 16}};
+  for (const std::uint32_t i : floor.indices) floor.corner_texcoords.push_back(uv[i]);
+  covrast::Material material;
+  material.base_color_texture = slot;
+  covrast::add_instance(scene, covrast::make_mesh(floor), {.material = material});
+  return scene;
+}
+
+}  // namespace
+
+TEST_CASE("textures: the level of detail on a tilted plane follows the derivative formula",
+          "[textures]") {
+  // 256x256 with nine levels, each one solid colour of its own (red = 20 x level + 10).
+  auto texture = std::make_shared<covrast::Texture>();
+  for (int level = 0, side = 256; side >= 1; ++level, side /= 2) {
+    covrast::TextureLevel l;
+    l.width = l.height = side;
+    const float red = float(srgb_decode(20 * level + 10));
+    l.texels.assign(std::size_t(side) * side, glm::vec4(red, 0.0f, 0.0f, 1.0f));
+    texture->levels.push_back(std::move(l));
+  }
+  covrast::TextureSlot slot;
+  slot.texture = texture;
+  slot.sampler.min = covrast::TextureFilter::Nearest;
+  slot.sampler.mag = covrast::TextureFilter::Nearest;
+  slot.sampler.mip = covrast::MipFilter::Nearest;
+  const int width = 160, height = 120;
+  const covrast::Scene scene = floor_scene(slot, width, height);
+  const covrast::Image image = render_mode(scene, "coverage");
+  // The exact mapping by ray casting: pixel (px, py) -> ray -> floor point -> (u, v).
+  const glm::dvec3 eye = scene.camera.eye;
+  const glm::dvec3 forward = glm::normalize(scene.camera.target - eye);
+  const glm::dvec3 right = glm::normalize(glm::cross(forward, scene.camera.up));
+  const glm::dvec3 up = glm::cross(right, forward);
+  const double half = std::tan(glm::radians(scene.camera.fovy_deg) / 2.0);
+  const auto uv_at = [&](double px, double py) {
+    const double nx = 2.0 * px / width - 1.0, ny = 1.0 - 2.0 * py / height;
+    const glm::dvec3 dir = forward + right * (nx * half * width / height) + up * (ny * half);
+    const double s = (-1.0 - eye.y) / dir.y;
+    const glm::dvec3 p = eye + dir * s;
+    return glm::dvec2((p.x + 4.0) / 8.0 * 2.0, (2.0 - p.z) / 42.0 * 16.0);
+  };
+  int checked = 0, mismatches = 0;
+  std::string report;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const double cx = x + 0.5, cy = y + 0.5;
+      // Only pixels wholly on the floor (edge pixels blend with the background).
+      bool inside = true;
+      for (const auto& corner :
+           {uv_at(x, y), uv_at(x + 1, y), uv_at(x, y + 1), uv_at(x + 1, y + 1)}) {
+        inside =
+            inside && corner.x > 0.01 && corner.x < 1.99 && corner.y > 0.01 && corner.y < 15.99;
+      }
+      // Pixels on the quad's diagonal (v = 8 u) are shaded by both triangles, each at its own
+      // clamped point: left out.
+      int side = 0;
+      for (const auto& corner :
+           {uv_at(x, y), uv_at(x + 1, y), uv_at(x, y + 1), uv_at(x + 1, y + 1)}) {
+        side |= corner.y > 8.0 * corner.x ? 1 : 2;
+      }
+      if (!inside || side == 3) continue;
+      const double h = 1e-3;
+      const glm::dvec2 ddx = (uv_at(cx + h, cy) - uv_at(cx - h, cy)) / (2 * h);
+      const glm::dvec2 ddy = (uv_at(cx, cy + h) - uv_at(cx, cy - h)) / (2 * h);
+      const double lod = std::log2(std::max(glm::length(ddx * 256.0), glm::length(ddy * 256.0)));
+      const int level = lod <= 0.5 ? 0 : std::min(8, int(std::ceil(lod + 0.5)) - 1);
+      // Skip pixels within 0.02 of a level switch (snapping moves the mapping slightly).
+      if (lod > 0.5 && std::abs((lod + 0.5) - std::round(lod + 0.5)) < 0.02) continue;
+      ++checked;
+      if (image.pixel(x, y)[0] != 20 * level + 10) {
+        ++mismatches;
+        if (mismatches <= 8) {
+          report += "pixel " + std::to_string(x) + "," + std::to_string(y) + " lod " +
+                    std::to_string(lod) + " level " + std::to_string(level) + " got " +
+                    std::to_string(image.pixel(x, y)[0]) + "; ";
+        }
+      }
+    }
+  }
+  INFO(report);
+  REQUIRE(checked > 5000);
+  REQUIRE(mismatches == 0);
+}
+
+TEST_CASE("textures: the same bytes for every thread count and tile size", "[textures]") {
+  const auto texture = covrast::make_texture("noise", 64, 32, random_rgba(64, 32, 5), true);
+  const covrast::Scene scene =
+      floor_scene(slot_of(texture, covrast::TextureFilter::Linear, covrast::TextureFilter::Linear,
+                          covrast::MipFilter::Linear),
+                  160, 120);
+  for (const char* mode : {"coverage", "aliased", "ssaa:2", "msaa:4"}) {
+    INFO(mode);
+    const covrast::Image first = render_mode(scene, mode, 1, 64);
+    for (const int threads : {2, 4}) {
+      for (const int tile : {8, 32, 256}) {
+        REQUIRE(render_mode(scene, mode, threads, tile).rgb == first.rgb);
+      }
+    }
+  }
+}
+
+namespace {
+
+std::string jpeg_bytes(const std::vector<std::uint8_t>& rgba, int width, int height) {
+  tjhandle handle = tjInitCompress();
+  unsigned char* out = nullptr;
+  unsigned long size = 0;
+  REQUIRE(tjCompress2(handle, rgba.data(), width, 0, height, TJPF_RGBA, &out, &size, TJSAMP_444,
+                      100, TJFLAG_ACCURATEDCT) == 0);
+  std::string bytes(reinterpret_cast<const char*>(out), size);
+  tjFree(out);
+  tjDestroy(handle);
+  return bytes;
+}
+
+std::string png_bytes(int width, int height, std::uint8_t value) {
+  covrast::Image image;
+  image.width = width;
+  image.height = height;
+  image.rgb.assign(std::size_t(width) * height * 3, value);
+  const std::vector<std::uint8_t> bytes = covrast::encode_png(image);
+  return std::string(bytes.begin(), bytes.end());
+}
+
+std::uint32_t crc32(const std::string& bytes) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (const char c : bytes) {
+    crc ^= std::uint8_t(c);
+    for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
+  }
+  return ~crc;
+}
+
+/// A glTF quad whose baseColorTexture is image 0 at `uri`.
+std::string textured_gltf(const std::string& uri, const nlohmann::json& extra = {}) {
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  const int uv = b.add_floats({0, 0, 1, 0, 1, 1}, "VEC2");
+  b.single_mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", 0}}});
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.gltf["textures"] = {{{"source", 0}}};
+  b.gltf["images"] = {{{"uri", uri}}};
+  if (!extra.is_null()) b.gltf.update(extra);
+  return b.gltf_text();
+}
+
+void write_file(const std::filesystem::path& path, const std::string& bytes) {
+  std::ofstream(path, std::ios::binary) << bytes;
+}
+
+}  // namespace
+
+TEST_CASE("textures: PNG and JPEG decoded by content, from files, data URIs and buffer views",
+          "[textures]") {
+  // JPEG at quality 100, 4:4:4: a smooth image survives within a few levels.
+  std::vector<std::uint8_t> rgba(32 * 16 * 4, 255);
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      rgba[(y * 32 + x) * 4 + 0] = std::uint8_t(x * 8);
+      rgba[(y * 32 + x) * 4 + 1] = std::uint8_t(y * 16);
+      rgba[(y * 32 + x) * 4 + 2] = 100;
+    }
+  }
+  const std::string jpeg = jpeg_bytes(rgba, 32, 16);
+  const covrast::RgbaImage decoded =
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(jpeg.data()), jpeg.size(), "j");
+  REQUIRE(decoded.width == 32);
+  REQUIRE(decoded.height == 16);
+  int worst = 0;
+  for (std::size_t i = 0; i < rgba.size(); ++i)
+    worst = std::max(worst, std::abs(decoded.rgba[i] - rgba[i]));
+  REQUIRE(worst <= 3);
+
+  covrast::test::TempDir dir("covrast-textures");
+  // A JPEG named .png loads: the content decides.
+  write_file(dir / "photo.png", jpeg);
+  write_file(dir / "a.gltf", textured_gltf("photo.png"));
+  const auto mesh = covrast::load_mesh(dir / "a.gltf");
+  REQUIRE(mesh->materials[0].base_color_texture.texture->levels[0].width == 32);
+  REQUIRE(mesh->corner_texcoords[0].size() == 3);
+  // The same image as a data: URI, and from a buffer view (.glb).
+  write_file(dir / "b.gltf",
+             textured_gltf("data:image/jpeg;base64," + covrast::test::base64(jpeg)));
+  REQUIRE(covrast::load_mesh(dir / "b.gltf")
+              ->materials[0]
+              .base_color_texture.texture->levels[0]
+              .height == 16);
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  const int view = b.add_view(png_bytes(4, 2, 128));
+  b.single_mesh({{{"attributes", {{"POSITION", pos}}}, {"material", 0}}});
+  b.gltf["materials"] = {{{"emissiveTexture", {{"index", 0}}}}};
+  b.gltf["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  b.gltf["samplers"] = {
+      {{"magFilter", 9728}, {"minFilter", 9986}, {"wrapS", 33071}, {"wrapT", 33648}}};
+  b.gltf["images"] = {{{"bufferView", view}, {"mimeType", "image/png"}}};
+  write_file(dir / "c.glb", b.glb());
+  const auto c = covrast::load_mesh(dir / "c.glb");
+  const covrast::TextureSlot& e = c->materials[0].emissive_texture;
+  REQUIRE(e.texture->levels[0].width == 4);
+  REQUIRE(e.texture->levels[0].texels[0].r == Approx(srgb_decode(128)).epsilon(1e-6));
+  REQUIRE(e.sampler.mag == covrast::TextureFilter::Nearest);
+  REQUIRE(e.sampler.min == covrast::TextureFilter::Nearest);
+  REQUIRE(e.sampler.mip == covrast::MipFilter::Linear);
+  REQUIRE(e.sampler.wrap_s == covrast::TextureWrap::ClampToEdge);
+  REQUIRE(e.sampler.wrap_t == covrast::TextureWrap::MirroredRepeat);
+}
+
+TEST_CASE("textures: KHR_texture_transform and texCoord are read per slot", "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(2, 2, 200));
+  nlohmann::json extra;
+  extra["materials"] = {{{"pbrMetallicRoughness",
+                          {{"baseColorTexture",
+                            {{"index", 0},
+                             {"texCoord", 0},
+                             {"extensions",
+                              {{"KHR_texture_transform",
+                                {{"offset", {0.5, -0.25}},
+                                 {"rotation", 1.5},
+                                 {"scale", {2, 3}},
+                                 {"texCoord", 1}}}}}}},
+                           {"metallicRoughnessTexture", {{"index", 0}, {"texCoord", 1}}}}},
+                         {"occlusionTexture", {{"index", 0}, {"strength", 0.5}}},
+                         {"normalTexture", {{"index", 0}, {"scale", 0.75}}}}};
+  write_file(dir / "t.gltf", textured_gltf("t.png", extra));
+  const auto mesh = covrast::load_mesh(dir / "t.gltf");
+  const covrast::Material& m = mesh->materials[0];
+  REQUIRE(m.base_color_texture.texcoord == 1);
+  REQUIRE(m.base_color_texture.transform.offset == glm::dvec2(0.5, -0.25));
+  REQUIRE(m.base_color_texture.transform.rotation == 1.5);
+  REQUIRE(m.base_color_texture.transform.scale == glm::dvec2(2, 3));
+  REQUIRE(m.metallic_roughness_texture.texcoord == 1);
+  REQUIRE(m.occlusion_texture.scale == 0.5f);
+  REQUIRE(m.normal_texture.scale == 0.75f);
+  // One image, two colour spaces: sRGB for base colour, linear for the others.
+  REQUIRE(m.base_color_texture.texture != m.metallic_roughness_texture.texture);
+  REQUIRE(m.metallic_roughness_texture.texture == m.occlusion_texture.texture);
+  REQUIRE(m.metallic_roughness_texture.texture->levels[0].texels[0].r == Approx(200 / 255.0));
+}
+
+TEST_CASE("textures: bad images are InputErrors naming the image and the model", "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  const auto load = [&](const std::string& uri) {
+    write_file(dir / "m.gltf", textured_gltf(uri));
+    return covrast::load_mesh(dir / "m.gltf");
+  };
+  REQUIRE_THROWS_WITH(load("missing.png"), Contains("m.gltf: image 0 (missing.png)") &&
+                                               Contains("No such file or directory"));
+  const std::string png = png_bytes(16, 16, 40);
+  write_file(dir / "cut.png", png.substr(0, png.size() / 2));
+  REQUIRE_THROWS_WITH(load("cut.png"), Contains("m.gltf: image 0 (cut.png)"));
+  // A forged header: 100000 x 100000 with a valid CRC, refused before allocating.
+  std::string huge = png_bytes(1, 1, 0);
+  for (int k = 0; k < 2; ++k) {
+    huge[16 + 4 * k] = 0;
+    huge[17 + 4 * k] = 1;
+    huge[18 + 4 * k] = char(0x86);
+    huge[19 + 4 * k] = char(0xA0);
+  }
+  const std::uint32_t crc = crc32(huge.substr(12, 17));
+  for (int k = 0; k < 4; ++k) huge[29 + k] = char(crc >> (24 - 8 * k));
+  write_file(dir / "huge.png", huge);
+  REQUIRE_THROWS_WITH(load("huge.png"), Contains("m.gltf: image 0 (huge.png)"));
+  const std::string jpeg = jpeg_bytes(random_rgba(16, 16, 1), 16, 16);
+  write_file(dir / "cut.jpg", jpeg.substr(0, jpeg.size() - 40));
+  REQUIRE_THROWS_WITH(load("cut.jpg"), Contains("m.gltf: image 0 (cut.jpg)"));
+  write_file(dir / "text.png", "not an image at all");
+  REQUIRE_THROWS_WITH(load("text.png"),
+                      Contains("image 0 (text.png)") && Contains("neither PNG nor JPEG"));
+  REQUIRE_THROWS_WITH(load("data:image/png;base64," + covrast::test::base64("garbage!")),
+                      Contains("m.gltf: image 0"));
+}
+
+TEST_CASE("textures: OBJ vt lines become corner UVs, v flipped to glTF's orientation",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "q.obj",
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0.25 0.75\n"
+             "f 1 2 3\nf 1/1 3/3 4/4\nf 1//1 2/-3 3\n");
+  const auto mesh = covrast::load_mesh(dir / "q.obj");
+  const std::vector<glm::vec2>& uv = mesh->corner_texcoords[0];
+  REQUIRE(uv.size() == 9);
+  REQUIRE(uv[0] == glm::vec2(0, 0));  // a face before the first with UVs: none
+  REQUIRE(uv[3] == glm::vec2(0, 1));
+  REQUIRE(uv[4] == glm::vec2(1, 0));
+  REQUIRE(uv[5] == glm::vec2(0.25f, 0.25f));
+  REQUIRE(uv[7] == glm::vec2(1, 1));  // -3 = the second vt line
+  write_file(dir / "bad.obj", "v 0 0 0\nvt 0 nan\n");
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "bad.obj"), Contains("bad.obj:2"));
+}
+
+namespace {
+
+/// A lit (Lambert) quad filling the image, with one texture slot set on its material by
+/// `set_slot`; the light rig is `lights`. Returns the centre pixel's red byte.
+template <class SetSlot>
+int lit_quad_red(const std::vector<covrast::Light>& lights, SetSlot set_slot) {
+  covrast::Scene scene = quad_scene(16, covrast::TextureSlot{});
+  covrast::Material material;
+  material.model = covrast::ShadingModel::Lambert;
+  set_slot(material);
+  scene.meshes[0].materials.assign(1, material);
+  for (const covrast::Light& light : lights) covrast::add_light(scene, light);
+  return render_mode(scene, "coverage").pixel(8, 8)[0];
+}
+
+covrast::TextureSlot solid_slot(std::uint8_t r, std::uint8_t g, std::uint8_t b, bool srgb) {
+  std::vector<std::uint8_t> rgba(16, 255);
+  for (std::size_t i = 0; i < 16; i += 4) {
+    rgba[i] = r;
+    rgba[i + 1] = g;
+    rgba[i + 2] = b;
+  }
+  covrast::TextureSlot slot;
+  slot.texture = covrast::make_texture("solid", 2, 2, rgba, srgb);
+  return slot;
+}
+
+}  // namespace
+
+TEST_CASE("textures: occlusion, emissive and normal textures in a lit scene", "[textures]") {
+  covrast::Light ambient;
+  ambient.type = covrast::LightType::Ambient;
+  ambient.intensity = 0.5;
+  const auto encoded = [](double linear) { return int(std::lround(srgb_encode_255(linear))); };
+  // Occlusion multiplies the ambient term: 1 + strength (R - 1) with R = 0.2.
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material&) {}) == encoded(0.5));
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.occlusion_texture = solid_slot(51, 0, 0, false);
+          }) == encoded(0.5 * 0.2));
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.occlusion_texture = solid_slot(51, 0, 0, false);
+            m.occlusion_texture.scale = 0.5f;
+          }) == encoded(0.5 * 0.6));
+  // Emission: factor x texture (sRGB 128), added.
+  REQUIRE(lit_quad_red({ambient}, [](covrast::Material& m) {
+            m.emissive_linear = glm::vec3(0.5f);
+            m.emissive_texture = solid_slot(128, 128, 128, true);
+          }) == encoded(0.5 + 0.5 * srgb_decode(128)));
+  // A light grazing along +x does not light the flat quad; a normal map that turns the normal
+  // to the tangent (+x, from the UVs: u grows along +x) faces it: n_ts = (1, 0, 0) from texel
+  // (255, 128, 128) is (1, 0.004, 0.004) before normalising.
+  covrast::Light grazing;
+  grazing.direction = {-1.0, 0.0, 0.0};
+  REQUIRE(lit_quad_red({grazing}, [](covrast::Material&) {}) == 0);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(1.0, 1.0 / 255.0, 1.0 / 255.0));
+  REQUIRE(lit_quad_red({grazing}, [](covrast::Material& m) {
+            m.normal_texture = solid_slot(255, 128, 128, false);
+          }) == encoded(n.x));
+}
+
+TEST_CASE("textures: TEXCOORD as normalized integers; a missing UV set is a warning",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(2, 2, 90));
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  // TEXCOORD_0: normalized unsigned short (v / 65535); TEXCOORD_1: normalized unsigned byte.
+  std::string u16, u8;
+  for (const std::uint16_t v : {0, 65535, 32768, 0, 65535, 65535}) covrast::test::put_u16(u16, v);
+  for (const std::uint8_t v : {0, 255, 51, 102, 255, 0}) covrast::test::put_u8(u8, v);
+  const int view16 = b.add_view(u16), view8 = b.add_view(u8);
+  b.gltf["accessors"].push_back({{"bufferView", view16},
+                                 {"componentType", 5123},
+                                 {"count", 3},
+                                 {"type", "VEC2"},
+                                 {"normalized", true}});
+  b.gltf["accessors"].push_back({{"bufferView", view8},
+                                 {"componentType", 5121},
+                                 {"count", 3},
+                                 {"type", "VEC2"},
+                                 {"normalized", true}});
+  const int uv0 = int(b.gltf["accessors"].size()) - 2, uv1 = uv0 + 1;
+  b.single_mesh({{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv0}, {"TEXCOORD_1", uv1}}},
+                  {"material", 0}},
+                 {{"attributes", {{"POSITION", pos}}}, {"material", 0}}});
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.gltf["textures"] = {{{"source", 0}}};
+  b.gltf["images"] = {{{"uri", "t.png"}}};
+  write_file(dir / "n.gltf", b.gltf_text());
+  const auto mesh = covrast::load_mesh(dir / "n.gltf");
+  REQUIRE(mesh->corner_texcoords[0].size() == 6);
+  REQUIRE(mesh->corner_texcoords[0][1] == glm::vec2(32768 / 65535.0f, 0.0f));
+  REQUIRE(mesh->corner_texcoords[1][1] == glm::vec2(0.2f, 0.4f));
+  REQUIRE(mesh->corner_texcoords[0][4] == glm::vec2(0.0f));  // the second primitive has none
+  write_file(dir / "s.json", R"({"width": 8, "height": 8, "camera": {"eye": [0, 0, 3],
+    "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40, "near": 0.1, "far": 10},
+    "meshes": [{"gltf": "n.gltf"}]})");
+  const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+  REQUIRE(scene.warnings.size() == 1);
+  REQUIRE_THAT(scene.warnings[0], Contains("1 primitives lack the TEXCOORD_n"));
+}
+
+TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "k.png", png_bytes(3, 2, 64));
+  const auto texture =
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true);
+  REQUIRE(texture->levels[0].width == 3);
+  REQUIRE(texture->levels[0].texels[0].g == Approx(srgb_decode(64)).epsilon(1e-6));
+  REQUIRE_THROWS_WITH(
+      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
+      Contains("m.obj: map_Kd no.png: cannot read image"));
+}
