@@ -48,14 +48,20 @@ struct SurfaceShading {
   glm::dvec3 specular{0.5};  ///< blinn-phong
   double shininess = 32.0;   ///< blinn-phong exponent
   bool double_sided = true;  ///< back faces get the flipped normal (front end)
+  /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
+  TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
+  double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
+  double base_alpha = 1.0;    ///< the base colour factor's alpha
   const ShadingContext* context = nullptr;
 };
 
-/// Per set-up triangle, in the TriangleSetup's vertex order. Normals are unit length and
-/// already face the viewer's side for back faces of double-sided materials.
+/// Per set-up triangle, in the TriangleSetup's vertex order (lit triangles, and every
+/// non-opaque one: an unlit one has zero positions and normals and an Unlit surface). Normals are
+/// unit length and already face the viewer's side for back faces of double-sided materials.
 struct ShadingRecord {
   glm::vec3 position_world[3];
   glm::vec3 normal_world[3];
+  float vertex_alpha[3];  ///< COLOR_0's alpha (1 without one)
   const SurfaceShading* surface;
 };
 

@@ -111,6 +111,7 @@ class ChunkSetups {
 struct ShadeVertex {
   glm::vec3 position_world;
   glm::vec3 normal_world;
+  float alpha = 1.0f;  ///< the vertex alpha (MeshData::color_alphas), for non-opaque surfaces
 };
 
 /// One chunk's ShadingRecords: fixed blocks, so a record's address (TriangleSetup::shading)
@@ -168,6 +169,9 @@ class GeometryFrontEnd {
   /// Whether an instance is lit: the scene has lights and some material of the instance is
   /// not ShadingModel::Unlit. Unlit instances take the unlit path bit for bit.
   bool instance_lit(std::size_t instance) const { return !lit_.empty() && lit_[instance]; }
+  /// Whether some material of an instance is not AlphaMode::Opaque: its triangles take the
+  /// lit path's per-material loop, and its non-opaque ones get a ShadingRecord for alpha.
+  bool instance_alpha(std::size_t instance) const { return !alpha_.empty() && alpha_[instance]; }
 
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order. The
   /// ShadingRecords of its lit triangles live in the front end until the same chunk is set up
@@ -228,7 +232,10 @@ class GeometryFrontEnd {
   /// inverse transpose of the model matrix's 3x3 part, `det_sign` the sign of its determinant).
   void shade_vertices(std::size_t instance, std::size_t local, const glm::dmat3& normal_matrix,
                       double det_sign, ShadeVertex out[3]) const;
-  /// Builds context_, surfaces_ and lit_ from the scene (constructor, lit scenes only).
+  /// The vertex alphas of triangle `local` of an instance into out[k].alpha.
+  void vertex_alphas(std::size_t instance, std::size_t local, ShadeVertex out[3]) const;
+  /// Builds context_, surfaces_, lit_ and alpha_ from the scene (constructor, lit scenes and
+  /// scenes with non-opaque materials only).
   void prepare_lighting();
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
@@ -261,6 +268,7 @@ class GeometryFrontEnd {
   ShadingContext context_;
   std::vector<std::vector<SurfaceShading>> surfaces_;
   std::vector<bool> lit_;
+  std::vector<bool> alpha_;
   mutable std::vector<ShadingArena> chunk_shading_;
 };
 

@@ -91,6 +91,7 @@ ABufferTile::ABufferTile(int tile_px)
   occluder_z_.resize(n);
   color_.resize(n);
   depth_.resize(n);
+  transparent_head_.resize(n);
 }
 
 void ABufferTile::begin_tile(const PixelRect& rect) {
@@ -103,6 +104,10 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   merged_slot_.clear();
   merged_.clear();
   samples_.clear();
+  if (any_transparent_) {
+    transparent_pool_.clear();
+    any_transparent_ = false;
+  }
 }
 
 PixelRect ABufferTile::block_rect(std::size_t b) const {
