@@ -392,6 +392,14 @@ TEST_CASE("Scene files and glTF files give the alpha mode, cutoff and alphas", "
   REQUIRE(mesh->materials.at(1).alpha_mode == covrast::AlphaMode::Mask);
   REQUIRE(mesh->materials.at(1).alpha_cutoff == 0.3);
   REQUIRE(mesh->color_alphas == std::vector<float>{0.25f, 0.5f, 1.0f});
+  b.gltf["materials"][1]["alphaMode"] = "CLEAR";
+  {
+    std::ofstream gltf(dir / "bad.gltf");
+    gltf << b.gltf_text();
+  }
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "bad.gltf"),
+                      Catch::Matchers::Contains("bad.gltf") &&
+                          Catch::Matchers::Contains("material 1: alphaMode \"CLEAR\""));
 }
 
 TEST_CASE("BLEND surfaces leave the depth output to the opaque ones", "[transparency]") {

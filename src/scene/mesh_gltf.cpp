@@ -154,8 +154,8 @@ Material convert_material(const tinygltf::Material& source) {
     }
   }
   m.double_sided = source.doubleSided;
-  // alphaMode, alphaCutoff and baseColorFactor's alpha (3.9.4); unknown modes are refused by
-  // the file's schema check in tinygltf, so anything else is OPAQUE.
+  // alphaMode, alphaCutoff and baseColorFactor's alpha (3.9.4); GltfMeshBuilder refuses other
+  // modes (tinygltf's default is "OPAQUE").
   m.alpha_mode = source.alphaMode == "MASK"    ? AlphaMode::Mask
                  : source.alphaMode == "BLEND" ? AlphaMode::Blend
                                                : AlphaMode::Opaque;
@@ -291,6 +291,11 @@ class GltfMeshBuilder {
     mesh_->source = name;
     // The file's materials, then glTF's default material for primitives without one.
     for (const tinygltf::Material& material : model.materials) {
+      const std::string& mode = material.alphaMode;
+      if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND") {
+        fail(name, "material " + std::to_string(mesh_->materials.size()) + ": alphaMode \"" + mode +
+                       "\" is not OPAQUE, MASK or BLEND");
+      }
       mesh_->materials.push_back(convert_material(material));
       if (material.emissiveTexture.index >= 0) ++emissive_textures_;
     }
