@@ -79,6 +79,20 @@ std::string mesh_source(const MeshInstance& instance) {
   return instance.mesh ? instance.mesh->source : std::string();
 }
 
+/// How many of an instance's materials are MASK and BLEND.
+struct AlphaCounts {
+  std::size_t mask = 0;
+  std::size_t blend = 0;
+};
+AlphaCounts alpha_counts(const MeshInstance& instance) {
+  AlphaCounts counts;
+  for (const Material& m : instance.materials) {
+    counts.mask += m.alpha_mode == AlphaMode::Mask;
+    counts.blend += m.alpha_mode == AlphaMode::Blend;
+  }
+  return counts;
+}
+
 nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
                                  std::size_t total_vertices) {
   nlohmann::ordered_json j;
@@ -97,6 +111,9 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
                                 {"color_source", color_source_name(instance.color_source)}};
     if (instance.color_source == ColorSource::Uniform) {
       m["color_linear"] = vec_json(glm::dvec3(instance.color_linear));
+    }
+    if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
+      m["alpha_materials"] = {{"mask", a.mask}, {"blend", a.blend}};
     }
     meshes.push_back(std::move(m));
   }
@@ -131,6 +148,9 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
               << color_source_name(instance.color_source);
     if (instance.color_source == ColorSource::Uniform) {
       std::cout << " " << vec_text(glm::dvec3(instance.color_linear)) << " (linear)";
+    }
+    if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
+      std::cout << ", alpha materials: " << a.mask << " mask, " << a.blend << " blend";
     }
     std::cout << '\n';
   }

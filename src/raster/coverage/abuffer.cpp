@@ -199,6 +199,8 @@ std::size_t ABufferTile::scratch_bytes() const {
   return opaque_.size() * (sizeof(void*) + sizeof(double) + 2 * sizeof(std::uint32_t) + 1 +
                            sizeof(glm::vec3) + sizeof(float)) +
          pool_.capacity() * sizeof(Fragment) + merged_slot_.capacity() * sizeof(std::uint32_t) +
-         merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples);
+         merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples) +
+         transparent_head_.size() * sizeof(std::uint32_t) +
+         transparent_pool_.capacity() * sizeof(Fragment);
 }
 }  // namespace covrast::detail
