@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "core/testing_hooks.hpp"
 #include "test_gltf_files.hpp"
 #include "test_tempdir.hpp"
 
@@ -424,4 +425,16 @@ TEST_CASE("BLEND surfaces leave the depth output to the opaque ones", "[transpar
     REQUIRE(a.depth.depth == b.depth.depth);
     REQUIRE(a.color.rgb != b.color.rgb);
   }
+}
+
+TEST_CASE("The uniform-layer shortcut gives what the per-sample composite gives",
+          "[transparency]") {
+  // Interior pixels of the three quads take the shortcut; with the mask resolve forced they
+  // take the 256-sample composite of the general formula.
+  const covrast::Scene scene = blend_quads({2, 0, 1});
+  const covrast::Image fast = render(scene, "coverage");
+  covrast::detail::testing::coverage_hooks.mask_resolve = true;
+  const covrast::Image samples = render(scene, "coverage");
+  covrast::detail::testing::coverage_hooks.mask_resolve = false;
+  REQUIRE(max_difference(fast, samples) <= 1);
 }

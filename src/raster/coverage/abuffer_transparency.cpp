@@ -20,6 +20,7 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "core/shading.hpp"
+#include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 
 #include <algorithm>
@@ -168,7 +169,8 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
   Transmittance tr;
   double transmit;
   glm::dvec3 light;
-  if (uniform_transparency(pixel, x, y, transmit, light)) {
+  if (!testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed) &&
+      uniform_transparency(pixel, x, y, transmit, light)) {
     // Interior of transparent surfaces in front of everything opaque: one transmittance for
     // the whole pixel (the general formula with S_j and keep_o constant).
     tr.fallback = transmit;
