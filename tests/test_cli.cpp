@@ -325,6 +325,18 @@ TEST_CASE("cli: info describes a good scene", "[cli]") {
   CHECK(bounds.at("max")[1].get<double>() == Approx(1.0));
   CHECK(bounds.at("max")[2].get<double>() == 0.0);
   CHECK(info.at("warnings").empty());
+  CHECK_FALSE(info.at("meshes")[0].contains("alpha_materials"));
+
+  // A BLEND material is counted, in text and JSON (docs/transparency.md).
+  std::string blend = scene_json("tri.obj");
+  blend.replace(blend.find("\"color\""), 0, "\"material\": {\"alpha_mode\": \"blend\"}, ");
+  write_text(dir / "blend.json", blend);
+  r = run_cli(dir, {"info", (dir / "blend.json").string()});
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.out.find("alpha materials: 0 mask, 1 blend") != std::string::npos);
+  r = run_cli(dir, {"info", (dir / "blend.json").string(), "--json"});
+  REQUIRE(r.exit_code == 0);
+  CHECK(nlohmann::json::parse(r.out).at("meshes")[0].at("alpha_materials").at("blend") == 1);
 
   r = run_cli(dir, {"info", (dir / "nope.json").string()});
   CHECK(r.exit_code == 2);

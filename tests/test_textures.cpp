@@ -709,3 +709,45 @@ TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") 
       covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
       Contains("m.obj: map_Kd no.png: cannot read image"));
 }
+
+TEST_CASE("textures: the base colour texture's alpha multiplies into BLEND and MASK",
+          "[textures][transparency]") {
+  // Random texels with random alpha on the image-filling quad, NEAREST: each pixel sees one
+  // texel, so BLEND gives c = t a + bg (1 - a) with a = base_alpha x texel alpha / 255, and
+  // MASK keeps the texel where a >= cutoff, in linear light.
+  std::vector<std::uint8_t> rgba = random_rgba(32, 32, 11);
+  std::uint32_t seed = 5;
+  for (std::size_t i = 3; i < rgba.size(); i += 4) {
+    seed = seed * 1664525u + 1013904223u;
+    rgba[i] = std::uint8_t(seed >> 24);
+  }
+  rgba[3] = 128;  // exactly at the MASK cutoff 128 / 255 below
+  rgba[7] = 127;  // just below it
+  const auto texture = covrast::make_texture("alpha", 32, 32, rgba, true);
+  covrast::Scene scene =
+      quad_scene(32, slot_of(texture, covrast::TextureFilter::Nearest,
+                             covrast::TextureFilter::Nearest, covrast::MipFilter::None));
+  scene.background_linear = {0.2f, 0.5f, 0.05f};
+  const double bg[3] = {0.2, 0.5, 0.05};
+  covrast::Material& material = scene.meshes[0].materials[0];
+  for (const bool blend : {true, false}) {
+    material.alpha_mode = blend ? covrast::AlphaMode::Blend : covrast::AlphaMode::Mask;
+    material.base_alpha = blend ? 0.5 : 1.0;
+    material.alpha_cutoff = 128.0 / 255.0;
+    for (const char* mode : {"coverage", "reference", "msaa:4", "aliased"}) {
+      INFO((blend ? "BLEND " : "MASK ") << mode);
+      const covrast::Image image = render_mode(scene, mode);
+      double worst = 0.0;
+      for (int i = 0; i < 32 * 32; ++i) {
+        const double a = material.base_alpha * rgba[4 * i + 3] / 255.0;
+        for (int c = 0; c < 3; ++c) {
+          const double texel = srgb_decode(rgba[4 * i + c]);
+          const double linear = blend ? texel * a + bg[c] * (1.0 - a)
+                                      : (rgba[4 * i + 3] >= 128 ? texel : bg[c]);
+          worst = std::max(worst, std::abs(image.rgb[3 * i + c] - srgb_encode_255(linear)));
+        }
+      }
+      REQUIRE(worst <= 1.0);
+    }
+  }
+}

@@ -41,6 +41,14 @@ enum class ShadingModel : std::uint8_t {
   Pbr,         ///< glTF 2.0 metallic-roughness BRDF (specification, Appendix B)
 };
 
+/// How a material's alpha (base_alpha x vertex alpha x texture alpha) is used (glTF 2.0,
+/// 3.9.4 alphaMode; docs/transparency.md).
+enum class AlphaMode : std::uint8_t {
+  Opaque,  ///< alpha ignored: the surface hides what is behind it
+  Mask,    ///< kept where alpha >= alpha_cutoff, opaque there, absent elsewhere
+  Blend,   ///< composited over what is behind it with its alpha, in depth order
+};
+
 /// A surface's material. The base colour is not here: it is the mesh's colour selection
 /// (uniform, per-triangle, vertex colours, glTF baseColorFactor x COLOR_0), as unlit.
 struct Material {
@@ -63,6 +71,11 @@ struct Material {
   TextureSlot normal_texture;
   TextureSlot occlusion_texture;
   TextureSlot emissive_texture;  ///< sRGB texels
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
+  /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
+  /// alpha (MeshData::color_alphas) and, later, the base colour texture's alpha.
+  double base_alpha = 1.0;
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
@@ -92,7 +105,10 @@ struct MeshData {
   std::string source;                    ///< file it came from (for messages)
   std::vector<glm::vec3> positions;      ///< object space
   std::vector<glm::vec3> colors_linear;  ///< per vertex, linear light; empty if none
-  std::vector<std::uint32_t> indices;    ///< 3 per triangle, in file order after fan split
+  /// Per vertex alpha (glTF COLOR_0 with four components), 0..1; empty: 1 everywhere. Used by
+  /// materials whose alpha_mode is not Opaque, whatever the instance's colour selection.
+  std::vector<float> color_alphas;
+  std::vector<std::uint32_t> indices;  ///< 3 per triangle, in file order after fan split
   std::size_t triangle_count() const { return indices.size() / 3; }
   /// Object-space normals, 3 per triangle in index order (a corner of one position may
   /// differ between faces, as OBJ's vn allows); empty if the file has none. A zero vector
@@ -234,6 +250,8 @@ struct MeshArrays {
   std::vector<std::uint32_t> indices{};
   /// Optional vertex colours: one per position, sRGB display values, each in 0..1.
   std::vector<glm::vec3> colors_srgb{};
+  /// Optional vertex alphas (MeshData::color_alphas): one per position, each in 0..1.
+  std::vector<float> alphas{};
   /// Optional normals: 3 per triangle in index order, finite; a zero vector means "use the
   /// face normal here" (MeshData::corner_normals).
   std::vector<glm::vec3> corner_normals{};

@@ -92,6 +92,20 @@ std::string mesh_source(const MeshInstance& instance) {
   return instance.mesh ? instance.mesh->source : std::string();
 }
 
+/// How many of an instance's materials are MASK and BLEND.
+struct AlphaCounts {
+  std::size_t mask = 0;
+  std::size_t blend = 0;
+};
+AlphaCounts alpha_counts(const MeshInstance& instance) {
+  AlphaCounts counts;
+  for (const Material& m : instance.materials) {
+    counts.mask += m.alpha_mode == AlphaMode::Mask;
+    counts.blend += m.alpha_mode == AlphaMode::Blend;
+  }
+  return counts;
+}
+
 nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
                                  std::size_t total_vertices) {
   nlohmann::ordered_json j;
@@ -113,6 +127,9 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
     }
     if (const std::size_t textures = texture_count(instance); textures > 0) {
       m["textures"] = textures;
+    }
+    if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
+      m["alpha_materials"] = {{"mask", a.mask}, {"blend", a.blend}};
     }
     meshes.push_back(std::move(m));
   }
@@ -150,6 +167,9 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
     }
     if (const std::size_t textures = texture_count(instance); textures > 0) {
       std::cout << " x " << textures << (textures == 1 ? " texture" : " textures");
+    }
+    if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
+      std::cout << ", alpha materials: " << a.mask << " mask, " << a.blend << " blend";
     }
     std::cout << '\n';
   }

@@ -46,4 +46,24 @@ inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool cl
                    float(p0 * t.color[0].b + p1 * t.color[1].b + p2 * t.color[2].b));
 }
 
+/// Alpha of a non-opaque triangle (it has a ShadingRecord) at the perspective-correct
+/// weights mu0..mu2: the one place where alpha is made (docs/transparency.md),
+///   alpha = base_alpha x (mu0 a0 + mu1 a1 + mu2 a2) x texture alpha (1 until textures),
+/// a_i the vertex alphas (COLOR_0's fourth component). Out of line (core/shading.cpp).
+double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2);
+
+/// Colour and alpha of a shading point.
+struct ShadedColor {
+  glm::vec3 rgb;
+  double alpha;
+};
+
+/// Colour and alpha of `t` at (x_px, y_px), with the same weights as shade(): opaque
+/// triangles are shade() and alpha 1, so their colour path is untouched. Out of line.
+ShadedColor shade_rgba(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside);
+
+/// Whether a Mask triangle keeps the point (x_px, y_px): alpha >= cutoff. True for Opaque
+/// and Blend triangles.
+bool mask_keeps(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside);
+
 }  // namespace covrast::detail

@@ -61,6 +61,10 @@ struct SurfaceShading {
   bool double_sided = true;  ///< back faces get the flipped normal (front end)
   /// Multiplies the ambient term only (the occlusion texture sets it per shading point).
   double occlusion = 1.0;
+  /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
+  TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
+  double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
+  double base_alpha = 1.0;    ///< the base colour factor's alpha
   const ShadingContext* context = nullptr;
   /// The textures this surface samples; null for an untextured one (no per-pixel texture
   /// work at all), and for an Unlit one without a base colour texture.
@@ -75,11 +79,13 @@ struct TexturedCorners {
   glm::vec4 tangent_world[3];
 };
 
-/// Per set-up triangle, in the TriangleSetup's vertex order. Normals are unit length and
-/// already face the viewer's side for back faces of double-sided materials.
+/// Per set-up triangle, in the TriangleSetup's vertex order (lit triangles, and every
+/// non-opaque one: an unlit one has zero positions and normals and an Unlit surface). Normals are
+/// unit length and already face the viewer's side for back faces of double-sided materials.
 struct ShadingRecord {
   glm::vec3 position_world[3];
   glm::vec3 normal_world[3];
+  float vertex_alpha[3];  ///< COLOR_0's alpha (1 without one)
   const SurfaceShading* surface;
   const TexturedCorners* textured = nullptr;  ///< null unless surface->textures
 };
@@ -99,6 +105,10 @@ struct SurfaceSample {
 /// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
                              const glm::dvec3& normal);
+
+/// The base colour texture's filtered alpha at the weights mu0..mu2 (1 without one): the
+/// texture term of surface_alpha, sampled exactly as sample_surface samples it.
+double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2);
 
 /// d(mu_i)/dx and d(mu_i)/dy of the perspective-correct barycentric weights of `t` at the
 /// point whose weights are mu0..mu2 (docs/textures.md has the derivation).

@@ -42,7 +42,8 @@ struct CoverageHooks {
   /// Read once per tile and per pixel: as list_resolve, and every pixel with fragments is
   /// resolved by its sub-pixel samples, never by adding areas (neither the sums nor the
   /// disjoint-set branches of resolve_pixel): the reference that the exact-area paths must
-  /// match within rounding.
+  /// match within rounding. Pixels with transparent fragments then take the per-sample
+  /// composite, never the uniform-layer shortcut (docs/transparency.md).
   std::atomic<bool> mask_resolve{false};
   /// Read when an A-buffer is made: it keeps at most this many fragments per pixel (clamped
   /// to 2..kMaxFragmentsPerPixel; 0 = kMaxFragmentsPerPixel), so that small scenes reach the

@@ -81,6 +81,15 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
 
 }  // namespace
 
+double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+  const ShadingRecord& r = *t.shading;
+  if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return 1.0;
+  const double mu[3] = {mu0, mu1, mu2};
+  return lookup(*r.surface->textures->base_color, *r.textured, mu,
+                weight_derivatives(t, mu0, mu1, mu2))
+      .a;
+}
+
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
                              const glm::dvec3& normal) {
   const ShadingRecord& r = *t.shading;

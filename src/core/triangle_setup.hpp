@@ -25,6 +25,10 @@ inline constexpr std::uint32_t kNoTriangle = 0xffffffffu;
 
 struct ShadingRecord;  // core/shading_inputs.hpp
 
+/// covrast::AlphaMode, mirrored here (core does not include the scene API). Non-opaque
+/// triangles always have a ShadingRecord, which holds what their alpha is made of.
+enum class TriangleAlpha : std::uint8_t { Opaque, Mask, Blend };
+
 struct TriangleSetup {
   /// Vertices in 24.8 fixed point, ordered so that the doubled signed area
   /// (x1-x0)(y2-y0) - (x2-x0)(y1-y0) is positive (clockwise on screen, y down).
@@ -47,6 +51,7 @@ struct TriangleSetup {
   /// Of a convex mesh under an affine model matrix: triangles of one surface and facing with
   /// this flag never overlap on screen (the A-buffer skips their overlap test).
   bool convex_surface;
+  TriangleAlpha alpha_mode;  ///< Opaque unless the material says otherwise
 
   double depth_at(double x_px, double y_px) const {
     return z0 + dzdx * (x_px - x_fx8[0] * (1.0 / kSubpixelOne)) +
@@ -56,6 +61,8 @@ struct TriangleSetup {
 
 // Two cache lines at most: the tile loop prefetches exactly two lines per triangle.
 static_assert(sizeof(TriangleSetup) <= 128);
+// The alpha mode lives in the padding after the flags: opaque scenes move no more bytes.
+static_assert(sizeof(TriangleSetup) == 120);
 
 /// Pixel bounds [x0, x1) x [y0, y1).
 struct PixelRect {

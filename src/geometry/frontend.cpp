@@ -179,7 +179,13 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       vertices_[i].color_linear.resize(scene.meshes[i].mesh->positions.size());
     }
   }
-  if (scene.lit || shows_textures(scene)) prepare_lighting();
+  bool any_alpha = false;
+  for (const MeshInstance& m : scene.meshes) {
+    for (const Material& material : m.materials) {
+      any_alpha = any_alpha || material.alpha_mode != AlphaMode::Opaque;
+    }
+  }
+  if (scene.lit || any_alpha || shows_textures(scene)) prepare_lighting();
 }
 
 namespace {
@@ -250,6 +256,9 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.specular = glm::dvec3(m.specular_linear);
   s.shininess = m.shininess;
   s.double_sided = m.double_sided;
+  s.alpha_mode = TriangleAlpha(int(m.alpha_mode));
+  s.alpha_cutoff = m.alpha_cutoff;
+  s.base_alpha = m.base_alpha;
   s.context = context;
   return s;
 }
@@ -258,6 +267,9 @@ static_assert(int(ShadingModel::Unlit) == int(LitModel::Unlit) &&
               int(ShadingModel::Lambert) == int(LitModel::Lambert) &&
               int(ShadingModel::BlinnPhong) == int(LitModel::BlinnPhong) &&
               int(ShadingModel::Pbr) == int(LitModel::Pbr));
+static_assert(int(AlphaMode::Opaque) == int(TriangleAlpha::Opaque) &&
+              int(AlphaMode::Mask) == int(TriangleAlpha::Mask) &&
+              int(AlphaMode::Blend) == int(TriangleAlpha::Blend));
 
 }  // namespace
 
@@ -273,6 +285,7 @@ void GeometryFrontEnd::prepare_lighting() {
   surfaces_.resize(scene_.meshes.size());
   textures_.resize(scene_.meshes.size());
   lit_.assign(scene_.meshes.size(), false);
+  alpha_.assign(scene_.meshes.size(), false);
   for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
     const std::vector<Material>& materials = scene_.meshes[i].materials;
     // All slots first: surfaces_ point into textures_[i], which must not move afterwards.
@@ -285,6 +298,7 @@ void GeometryFrontEnd::prepare_lighting() {
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;
       }
+      if (materials[k].alpha_mode != AlphaMode::Opaque) alpha_[i] = true;
     }
     if (surfaces_[i].empty()) surfaces_[i].push_back(surface_shading(Material{}, &context_));
     if (lit_[i]) vertices_[i].position_world.resize(scene_.meshes[i].mesh->positions.size());
@@ -315,7 +329,8 @@ unsigned GeometryFrontEnd::cullable_facing(const MeshInstance& instance, const g
 }
 
 unsigned GeometryFrontEnd::drop_facing(std::size_t instance) const {
-  if (!cull_hidden_backfaces_) return 0;
+  // A MASK or BLEND surface may show its back faces through its front ones.
+  if (!cull_hidden_backfaces_ || instance_alpha(instance)) return 0;
   // (a) and (b) from the instance as it is now (its model matrix may change between frames).
   // Once per instance and chunk; meshes that are not closed stop at the first test.
   const unsigned facing = cullable_facing(scene_.meshes[instance], eye_);
@@ -500,7 +515,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
     sink.convex_surface = convex_surface(instance);
-    if (instance_lit(instance)) {
+    if (instance_lit(instance) || instance_alpha(instance)) {
       setup_lit_run(instance, g, run_end, sink);
       g = run_end;
       continue;
@@ -628,6 +643,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.flat_color = flat;
   t.convex_surface = sink.convex_surface;
   t.shading = nullptr;
+  t.alpha_mode = TriangleAlpha::Opaque;
   if (lit != nullptr) {
     // Computed only now, for triangles that survived every cull (half of a closed mesh's
     // are hidden back faces).
@@ -647,6 +663,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     for (int k = 0; k < 3; ++k) {
       record.position_world[k] = ordered[k]->position_world;
       record.normal_world[k] = sign * ordered[k]->normal_world;
+      record.vertex_alpha[k] = ordered[k]->alpha;
     }
     record.surface = lit;
     record.textured = nullptr;
@@ -660,6 +677,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
       }
       record.textured = &corners;
     }
+    t.alpha_mode = lit->alpha_mode;
     t.shading = &record;
     t.flat_color = false;
   }
@@ -709,6 +727,7 @@ void GeometryFrontEnd::clip_triangle(std::size_t instance, const glm::dmat4& mvp
           }
           next[n].shade.tangent_world =
               a_in.tangent_world + float(t) * (a_out.tangent_world - a_in.tangent_world);
+          next[n].shade.alpha = a_in.alpha + float(t) * (a_out.alpha - a_in.alpha);
         }
         ++n;
       }
@@ -754,6 +773,7 @@ void GeometryFrontEnd::shade_vertices(std::size_t instance, std::size_t local,
   const glm::dvec3 face_unit = face_length > 0.0 ? face / face_length : glm::dvec3(0.0);
   const glm::vec3* corners =
       inst.corner_normals != nullptr ? inst.corner_normals->data() + local * 3 : nullptr;
+  vertex_alphas(instance, local, out);
   for (int k = 0; k < 3; ++k) {
     out[k].position_world = world[idx[k]];
     glm::dvec3 n = face_unit;
@@ -809,6 +829,15 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
   for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(glm::vec3(tangent), w);
 }
 
+void GeometryFrontEnd::vertex_alphas(std::size_t instance, std::size_t local,
+                                     ShadeVertex out[3]) const {
+  const MeshData& mesh = *scene_.meshes[instance].mesh;
+  const std::uint32_t* idx = mesh.indices.data() + local * 3;
+  for (int k = 0; k < 3; ++k) {
+    out[k].alpha = idx[k] < mesh.color_alphas.size() ? mesh.color_alphas[idx[k]] : 1.0f;
+  }
+}
+
 void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end,
                                      Sink& sink) const {
   const MeshInstance& inst = scene_.meshes[instance];
@@ -849,18 +878,22 @@ void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std:
       ++sink.counters.culled;
       continue;
     }
-    // Unlit and untextured: no shading inputs at all, the unlit path bit for bit.
+    // Unlit and untextured: no shading inputs at all, the unlit path bit for bit; unlit
+    // non-opaque ones get a record for their alpha (vertex alphas only, no positions or normals).
     const bool unlit = lit->model == LitModel::Unlit && lit->textures == nullptr;
+    const bool record = !unlit || lit->alpha_mode != TriangleAlpha::Opaque;
+    ShadeVertex shade[3];
+    if (unlit && record) vertex_alphas(instance, local, shade);
     if ((o0 | o1 | o2) == 0) {
       const LazyShade lazy{instance, local, &normal_matrix, &linear, det_sign};
       emit_triangle(iv.snapped[indices[0]], iv.snapped[indices[1]], iv.snapped[indices[2]],
                     color[0], color[1], color[2], flat, primitive, std::uint32_t(instance), sink,
-                    nullptr, unlit ? nullptr : lit, &lazy);
+                    record && unlit ? shade : nullptr, record ? lit : nullptr,
+                    unlit ? nullptr : &lazy);
     } else {
-      ShadeVertex shade[3];
       if (!unlit) shade_vertices(instance, local, normal_matrix, linear, det_sign, *lit, shade);
       clip_triangle(instance, mvp, indices, color, flat, o0 | o1 | o2, primitive, sink,
-                    unlit ? nullptr : shade, unlit ? nullptr : lit);
+                    record ? shade : nullptr, record ? lit : nullptr);
     }
   }
 }

@@ -114,6 +114,7 @@ struct ShadeVertex {
   /// Textured triangles only (TexturedCorners): both UV sets and the world tangent.
   glm::vec2 uv[kMaxTexcoordSets];
   glm::vec4 tangent_world;
+  float alpha = 1.0f;  ///< the vertex alpha (MeshData::color_alphas), for non-opaque surfaces
 };
 
 /// One chunk's ShadingRecords (or TexturedCorners): fixed blocks, so a record's address
@@ -175,6 +176,9 @@ class GeometryFrontEnd {
   /// material of the instance is not ShadingModel::Unlit, or some material shows a texture
   /// (lit or not). Other instances take the unlit path bit for bit.
   bool instance_lit(std::size_t instance) const { return !lit_.empty() && lit_[instance]; }
+  /// Whether some material of an instance is not AlphaMode::Opaque: its triangles take the
+  /// lit path's per-material loop, and its non-opaque ones get a ShadingRecord for alpha.
+  bool instance_alpha(std::size_t instance) const { return !alpha_.empty() && alpha_[instance]; }
 
   /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order. The
   /// ShadingRecords of its lit triangles live in the front end until the same chunk is set up
@@ -242,20 +246,25 @@ class GeometryFrontEnd {
   /// The UVs and world tangents of a textured triangle's corners (shade_vertices).
   void texture_vertices(const MeshInstance& inst, std::size_t local, const glm::dmat3& linear,
                         double det_sign, const SurfaceShading& surface, ShadeVertex out[3]) const;
-  /// Builds context_, surfaces_ and lit_ from the scene (constructor, lit scenes only).
+  /// The vertex alphas of triangle `local` of an instance into out[k].alpha.
+  void vertex_alphas(std::size_t instance, std::size_t local, ShadeVertex out[3]) const;
+  /// Builds context_, surfaces_, lit_ and alpha_ from the scene (constructor: lit scenes,
+  /// scenes with textures and scenes with non-opaque materials only).
   void prepare_lighting();
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
-  /// Whether an instance's triangles are of a convex surface (TriangleSetup::convex_surface):
-  /// its mesh is convex (current analysis) and its model matrix affine, which keeps it convex;
-  /// its faces of one facing then cover each point of the screen at most once, from any eye
-  /// (clipping only cuts them smaller).
+  /// Whether an instance's triangles are of a convex surface
+  /// (TriangleSetup::convex_surface): its mesh is convex (current analysis) and
+  /// its model matrix affine, which keeps it convex; its faces of one facing
+  /// then cover each point of the screen at most once, from any eye (clipping
+  /// only cuts them smaller).
   bool convex_surface(std::size_t instance) const;
-  /// Conditions (a) and (b) (see frontend.cpp): the facing to drop if no vertex is clipped by
-  /// the near or far plane, or 0.
+  /// Conditions (a) and (b) (see frontend.cpp): the facing to drop if no vertex
+  /// is clipped by the near or far plane, or 0.
   static unsigned cullable_facing(const MeshInstance& instance, const glm::dvec3& eye);
 
-  /// TriangleSetup::front_facing false (clockwise in NDC) / true (counter-clockwise).
+  /// TriangleSetup::front_facing false (clockwise in NDC) / true
+  /// (counter-clockwise).
   static constexpr unsigned kDropClockwise = 1;
   static constexpr unsigned kDropCounterClockwise = 2;
 
@@ -270,13 +279,16 @@ class GeometryFrontEnd {
   std::vector<InstanceVertices> vertices_;
   bool cull_hidden_backfaces_;
   glm::dvec3 eye_;  ///< the camera position the view matrix was built from [world]
-  // Lighting (empty for unlit scenes). surfaces_[i][m]: instance i's material m, pointing at
-  // context_; chunk_shading_[c]: the records of chunk c, written only by setup_chunk(c).
+  // Lighting (empty for unlit scenes). surfaces_[i][m]: instance i's material
+  // m, pointing at context_; chunk_shading_[c]: the records of chunk c, written
+  // only by setup_chunk(c).
   ShadingContext context_;
   std::vector<std::vector<SurfaceShading>> surfaces_;
-  /// textures_[i][m]: instance i's material m's slots, where surfaces_[i][m].textures points.
+  /// textures_[i][m]: instance i's material m's slots, where
+  /// surfaces_[i][m].textures points.
   std::vector<std::vector<SurfaceTextures>> textures_;
   std::vector<bool> lit_;
+  std::vector<bool> alpha_;
   mutable std::vector<ShadingArena> chunk_shading_;
   mutable std::vector<TexturedArena> chunk_textured_;
 };

@@ -149,6 +149,16 @@ Material convert_material(const tinygltf::Material& source) {
     }
   }
   m.double_sided = source.doubleSided;
+  // alphaMode, alphaCutoff and baseColorFactor's alpha (3.9.4); GltfMeshBuilder refuses other
+  // modes (tinygltf's default is "OPAQUE").
+  m.alpha_mode = source.alphaMode == "MASK"    ? AlphaMode::Mask
+                 : source.alphaMode == "BLEND" ? AlphaMode::Blend
+                                               : AlphaMode::Opaque;
+  // In double, as the file gives them (a cutoff of 0.3 stays 0.3); NaN becomes 0.
+  const auto unit = [](double v) { return v >= 0.0 ? std::min(v, 1.0) : 0.0; };
+  m.alpha_cutoff = unit(source.alphaCutoff);
+  const std::vector<double>& factor = source.pbrMetallicRoughness.baseColorFactor;
+  if (factor.size() == 4) m.base_alpha = unit(factor[3]);
   return m;
 }
 
@@ -283,6 +293,11 @@ class GltfMeshBuilder {
     // material for primitives without one.
     GltfTextures textures(model, reader_, base_dir);
     for (std::size_t i = 0; i < model.materials.size(); ++i) {
+      const std::string& mode = model.materials[i].alphaMode;
+      if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND") {
+        fail(name, "material " + std::to_string(i) + ": alphaMode \"" + mode +
+                       "\" is not OPAQUE, MASK or BLEND");
+      }
       mesh_->materials.push_back(convert_material(model.materials[i]));
       textures.apply(model.materials[i], int(i), mesh_->materials.back());
     }
@@ -312,6 +327,7 @@ class GltfMeshBuilder {
                                 " primitives lack the TEXCOORD_n their material's textures use; "
                                 "UV (0, 0) used there");
     }
+    if (any_color_alpha_) mesh_->color_alphas = std::move(alphas_);
     if (any_color_attribute_ || factors_differ_) {
       // Per-vertex colours: COLOR_0 where present, each primitive's own factor elsewhere.
       mesh_->colors_linear = std::move(colors_);
@@ -367,7 +383,8 @@ class GltfMeshBuilder {
     if (vertex_count > kMaxVertices - mesh_->positions.size()) fail(name_, "too many vertices");
     const std::vector<std::uint32_t> corners = triangle_corners(
         mode, vertex_sequence(source, what, vertex_count), primitive.indices >= 0, what);
-    const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count);
+    std::vector<float> alphas;
+    const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count, alphas);
     const TextureAttributes texture_attributes =
         read_texture_attributes(source, what, vertex_count);
     const std::uint32_t material = primitive.material >= 0
@@ -376,13 +393,13 @@ class GltfMeshBuilder {
     count_missing_texcoords(texture_attributes, material);
     if (placement.skin_joints.empty()) {
       for (const glm::dmat4& world : placement.worlds) {
-        place(vertices, corners, colors, material, world, texture_attributes);
+        place(vertices, corners, colors, alphas, material, world, texture_attributes);
       }
     } else {
       const std::vector<glm::dmat4> skin =
           vertex_skin_matrices(skin_influences(source, vertices.count(), what), vertices.count(),
                                placement.skin_joints, name_, what);
-      place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0),
+      place(skinned(vertices, skin), corners, colors, alphas, material, glm::dmat4(1.0),
             texture_attributes);
     }
   }
@@ -447,7 +464,8 @@ class GltfMeshBuilder {
   /// Appends one placed copy of a primitive: its vertices moved by `world`, its colours, its
   /// triangles (turned when `world` mirrors), their material and their normals.
   void place(const PrimitiveVertices& vertices, const std::vector<std::uint32_t>& corners,
-             const std::vector<glm::vec3>& colors, std::uint32_t material, const glm::dmat4& world,
+             const std::vector<glm::vec3>& colors, const std::vector<float>& alphas,
+             std::uint32_t material, const glm::dmat4& world,
              const TextureAttributes& texture_attributes) {
     const std::size_t base = mesh_->positions.size();
     const std::vector<double>& positions = vertices.positions;
@@ -458,6 +476,7 @@ class GltfMeshBuilder {
                                     static_cast<float>(p_world.z));
     }
     colors_.insert(colors_.end(), colors.begin(), colors.end());
+    alphas_.insert(alphas_.end(), alphas.begin(), alphas.end());
     const std::size_t first_index = mesh_->indices.size();
     add_triangles(corners, base);
     // glTF 2.0, 3.7.2.1: a node with a negative determinant turns its faces' winding
@@ -632,9 +651,11 @@ class GltfMeshBuilder {
   }
 
   /// The primitive's vertex colours: COLOR_0 x baseColorFactor, or the (clamped) factor
-  /// alone. Notes what decides the mesh's colour selection (finish()).
+  /// alone. Notes what decides the mesh's colour selection (finish()). `alphas`: COLOR_0's
+  /// fourth component (clamped to 0..1), or 1 (the factor's alpha is Material::base_alpha).
   std::vector<glm::vec3> vertex_colors(const PrimitiveSource& source, const std::string& what,
-                                       std::size_t vertex_count) {
+                                       std::size_t vertex_count, std::vector<float>& alphas) {
+    alphas.assign(vertex_count, 1.0f);
     const glm::dvec3 factor = base_color_factor(source.primitive, what);
     const glm::vec3 factor_clamped(clamp_unit(factor.r), clamp_unit(factor.g),
                                    clamp_unit(factor.b));
@@ -656,6 +677,12 @@ class GltfMeshBuilder {
     }
     std::vector<glm::vec3> colors;
     colors.reserve(vertex_count);
+    if (components == 4) {
+      any_color_alpha_ = true;
+      for (std::size_t v = 0; v < vertex_count; ++v) {
+        alphas[v] = static_cast<float>(clamp_unit((*values)[width * v + 3]));
+      }
+    }
     for (std::size_t v = 0; v < vertex_count; ++v) {
       colors.emplace_back(clamp_unit((*values)[width * v] * factor.r),
                           clamp_unit((*values)[width * v + 1] * factor.g),
@@ -835,6 +862,8 @@ class GltfMeshBuilder {
   /// node that uses them.
   std::array<std::size_t, 4> undrawn_primitives_{};
   std::vector<glm::vec3> colors_;  ///< per vertex: COLOR_0 x factor, or the factor alone
+  std::vector<float> alphas_;      ///< per vertex: COLOR_0's alpha, or 1
+  bool any_color_alpha_ = false;   ///< some COLOR_0 has four components
   bool any_color_attribute_ = false;
   bool any_primitive_ = false;
   bool factors_differ_ = false;

@@ -57,6 +57,8 @@ void check_material(const Material& m, const std::string& what) {
     if (slot->texture && slot->texture->levels.empty()) fail(what, "a texture has no texels");
     if (!std::isfinite(slot->scale)) fail(what, "a texture's scale must be finite");
   }
+  if (!(m.alpha_cutoff >= 0.0 && m.alpha_cutoff <= 1.0)) fail(what, "alpha_cutoff must be in 0..1");
+  if (!(m.base_alpha >= 0.0 && m.base_alpha <= 1.0)) fail(what, "base_alpha must be in 0..1");
 }
 
 /// Finite, with the last row (0, 0, 0, 1): model[col][row] in GLM.
@@ -108,6 +110,10 @@ void check_mesh_arrays(const MeshData& mesh, const std::string& what) {
   }
   if (!mesh.colors_linear.empty() && mesh.colors_linear.size() != mesh.positions.size()) {
     fail(what, std::to_string(mesh.colors_linear.size()) + " colours for " +
+                   std::to_string(mesh.positions.size()) + " positions");
+  }
+  if (!mesh.color_alphas.empty() && mesh.color_alphas.size() != mesh.positions.size()) {
+    fail(what, std::to_string(mesh.color_alphas.size()) + " vertex alphas for " +
                    std::to_string(mesh.positions.size()) + " positions");
   }
   if (!mesh.corner_normals.empty() && mesh.corner_normals.size() != mesh.indices.size()) {
@@ -164,6 +170,12 @@ std::shared_ptr<const MeshData> make_mesh(MeshArrays arrays) {
                                        srgb_to_linear(c.b));
     }
   }
+  for (std::size_t i = 0; i < arrays.alphas.size(); ++i) {
+    if (!(arrays.alphas[i] >= 0.0f && arrays.alphas[i] <= 1.0f)) {
+      fail(name, "alphas[" + std::to_string(i) + "] not in 0..1");
+    }
+  }
+  mesh->color_alphas = std::move(arrays.alphas);
   for (std::size_t i = 0; i < arrays.corner_normals.size(); ++i) {
     if (!finite(arrays.corner_normals[i])) {
       fail(name, "corner_normals[" + std::to_string(i) + "] is not finite");

@@ -329,6 +329,22 @@ class SceneReader {
       }
       m.double_sided = it->get<bool>();
     }
+    if (const auto it = object.find("alpha_mode"); it != object.end()) {
+      m.alpha_mode = alpha_mode(*it, key + ".alpha_mode");
+    }
+    if (const auto it = object.find("alpha_cutoff"); it != object.end()) {
+      m.alpha_cutoff = number_in(*it, key + ".alpha_cutoff", 0.0, 1.0);
+    }
+    if (const auto it = object.find("base_alpha"); it != object.end()) {
+      m.base_alpha = number_in(*it, key + ".base_alpha", 0.0, 1.0);
+    }
+  }
+
+  AlphaMode alpha_mode(const json& value, const std::string& path) const {
+    if (value == "opaque") return AlphaMode::Opaque;
+    if (value == "mask") return AlphaMode::Mask;
+    if (value == "blend") return AlphaMode::Blend;
+    fail(file_, path, "expected \"opaque\", \"mask\" or \"blend\", got " + shown(value));
   }
 
   NormalSource normal_source(const json& value, const std::string& path) const {

@@ -15,6 +15,7 @@
 #include "raster/rasterizers.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -34,6 +35,13 @@ std::uint64_t flat_owner(const std::uint8_t code[3]) {
          std::uint64_t(code[2]) << 24;
 }
 
+/// The linear value of an 8-bit sRGB code (IEC 61966-2-1): encode_srgb8 of it gives the code
+/// back, so a pixel that no BLEND triangle covers keeps its bytes.
+double decode_srgb8(std::uint8_t code) {
+  const double c = code / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
 void write_codes(std::uint64_t owner, std::uint8_t* dst) {
   dst[0] = std::uint8_t(owner >> 8);
   dst[1] = std::uint8_t(owner >> 16);
@@ -50,6 +58,7 @@ class AliasedRasterizer final : public TileRasterizer {
 
   void begin_tile(const PixelRect& rect, const FrameTarget&) override {
     rect_ = rect;
+    blend_.clear();
     // Owners need no clearing: they are read only where a depth was written.
     std::fill(depth_.begin(), depth_.end(), std::numeric_limits<double>::infinity());
   }
@@ -63,6 +72,14 @@ class AliasedRasterizer final : public TileRasterizer {
     const PixelRect r = intersect(touched_pixels(t), rect_);
     if (r.empty()) return;
     std::uint64_t id = std::uint64_t(here);
+    if (t.alpha_mode == TriangleAlpha::Blend) {
+      blend_.push_back(&t);  // composited at the end of the tile, in depth order
+      return;
+    }
+    if (t.alpha_mode == TriangleAlpha::Mask) {
+      raster_mask(t, r, id);
+      return;
+    }
     if (t.flat_color) {
       // shade() of a flat triangle is color[0] everywhere: encode it now, once per run of
       // triangles of one colour.
@@ -118,6 +135,84 @@ class AliasedRasterizer final : public TileRasterizer {
         for (int i = 0; i < width; ++i) out[i] = std::min(float(depth_row[i]), 1.0f);
       }
     }
+    if (!blend_.empty()) composite_blend(target);
+  }
+
+  /// A MASK triangle: the scalar twin's test (aliased_kernel_scalar.cpp) with the alpha test
+  /// at the sample (the pixel centre) before the depth test.
+  void raster_mask(const TriangleSetup& t, const PixelRect& r, std::uint64_t id) {
+    const AliasedJob job = make_aliased_job(
+        t, r, AliasedTile{rect_, depth_.data(), owner_.data(), std::size_t(stride_)}, id);
+    std::int64_t row[3] = {job.e[0], job.e[1], job.e[2]};
+    for (int j = 0; j < job.height; ++j) {
+      const double py = job.y0 + j + 0.5;
+      const double zy = job.dzdy * (py - job.vy);
+      double* depth = job.depth + std::size_t(j) * job.stride;
+      std::uint64_t* owner = job.owner + std::size_t(j) * job.stride;
+      for (int i = 0; i < job.width; ++i) {
+        const std::int64_t e0 = row[0] + i * job.step_x[0], e1 = row[1] + i * job.step_x[1],
+                           e2 = row[2] + i * job.step_x[2];
+        if ((e0 | e1 | e2) < 0) continue;
+        const double px = (job.x0 + i) + 0.5;
+        const float z = float(job.z0 + job.dzdx * (px - job.vx) + zy);
+        if (z < depth[i] && mask_keeps(t, px, py, false)) {
+          depth[i] = z;
+          owner[i] = job.id;
+        }
+      }
+      for (int k = 0; k < 3; ++k) row[k] += job.step_y[k];
+    }
+  }
+
+  /// BLEND triangles, per pixel centre: the ones that cover it in front of the opaque depth,
+  /// sorted nearest first (level ones by primitive index), composited over the opaque colour
+  /// (docs/transparency.md); the depth stays the opaque one.
+  void composite_blend(const FrameTarget& target) {
+    std::vector<std::pair<float, const TriangleSetup*>> stack;
+    for (int y = rect_.y0; y < rect_.y1; ++y) {
+      for (int x = rect_.x0; x < rect_.x1; ++x) {
+        const std::size_t i = std::size_t(y - rect_.y0) * stride_ + std::size_t(x - rect_.x0);
+        const PixelRect one{x, y, x + 1, y + 1};
+        stack.clear();
+        for (const TriangleSetup* t : blend_) {
+          const PixelRect r = intersect(touched_pixels(*t), one);
+          if (r.empty()) continue;
+          const AliasedJob job = make_aliased_job(
+              *t, r, AliasedTile{rect_, depth_.data(), owner_.data(), std::size_t(stride_)}, 0);
+          if ((job.e[0] | job.e[1] | job.e[2]) < 0) continue;
+          const float z =
+              float(job.z0 + job.dzdx * ((x + 0.5) - job.vx) + job.dzdy * ((y + 0.5) - job.vy));
+          if (z < depth_[i]) stack.emplace_back(z, t);
+        }
+        if (stack.empty()) continue;
+        std::sort(stack.begin(), stack.end(), [](const auto& a, const auto& b) {
+          return a.first < b.first ||
+                 (a.first == b.first && a.second->primitive < b.second->primitive);
+        });
+        std::uint8_t* dst = target.color->pixel(x, y);
+        glm::dvec3 behind(target.background_linear);
+        if (depth_[i] != std::numeric_limits<double>::infinity()) {
+          const std::uint64_t owner = owner_[i];
+          if (owner & kFlatTag) {
+            // The flat colour's 8-bit code, decoded (the owner keeps no linear colour).
+            for (int k = 0; k < 3; ++k) behind[k] = decode_srgb8(dst[k]);
+          } else {
+            const auto& o = *reinterpret_cast<const TriangleSetup*>(std::uintptr_t(owner));
+            behind = glm::dvec3(shade(o, x + 0.5, y + 0.5, false));
+          }
+        }
+        glm::dvec3 c(0.0);
+        double transmit = 1.0;
+        for (const auto& layer : stack) {
+          const ShadedColor sc = shade_rgba(*layer.second, x + 0.5, y + 0.5, false);
+          const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
+          c += transmit * alpha * glm::dvec3(sc.rgb);
+          transmit *= 1.0 - alpha;
+        }
+        c += transmit * behind;
+        for (int k = 0; k < 3; ++k) dst[k] = encode_srgb8(float(c[k]));
+      }
+    }
   }
 
   std::size_t scratch_bytes() const override {
@@ -131,7 +226,8 @@ class AliasedRasterizer final : public TileRasterizer {
   /// Depth per pixel: float values (as the depth test rounds them), held in doubles so the
   /// kernels compare and blend them in their 64-bit lanes without narrowing conversions.
   std::vector<double> depth_;
-  std::vector<std::uint64_t> owner_;  ///< per pixel, see kFlatTag
+  std::vector<std::uint64_t> owner_;         ///< per pixel, see kFlatTag
+  std::vector<const TriangleSetup*> blend_;  ///< the tile's BLEND triangles
   /// The last flat colour encoded, and its owner value (NaN: none yet).
   glm::vec3 flat_color_{std::numeric_limits<float>::quiet_NaN()};
   std::uint64_t flat_owner_ = 0;

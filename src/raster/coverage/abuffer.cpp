@@ -91,6 +91,7 @@ ABufferTile::ABufferTile(int tile_px)
   occluder_z_.resize(n);
   color_.resize(n);
   depth_.resize(n);
+  transparent_head_.resize(n);
 }
 
 void ABufferTile::begin_tile(const PixelRect& rect) {
@@ -103,6 +104,10 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   merged_slot_.clear();
   merged_.clear();
   samples_.clear();
+  if (any_transparent_) {
+    transparent_pool_.clear();
+    any_transparent_ = false;
+  }
 }
 
 PixelRect ABufferTile::block_rect(std::size_t b) const {
@@ -194,6 +199,8 @@ std::size_t ABufferTile::scratch_bytes() const {
   return opaque_.size() * (sizeof(void*) + sizeof(double) + 2 * sizeof(std::uint32_t) + 1 +
                            sizeof(glm::vec3) + sizeof(float)) +
          pool_.capacity() * sizeof(Fragment) + merged_slot_.capacity() * sizeof(std::uint32_t) +
-         merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples);
+         merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples) +
+         transparent_head_.size() * sizeof(std::uint32_t) +
+         transparent_pool_.capacity() * sizeof(Fragment);
 }
 }  // namespace covrast::detail

@@ -116,6 +116,11 @@ class ABufferTile {
   /// any block was decided; the caller skips their pixels (block_decided).
   bool add_covering_blocks(const TriangleSetup& t, const PixelRect& r);
   bool block_decided(int x, int y) const { return decided_[block_of(x, y)] == decided_stamp_; }
+  /// A fragment of a BLEND triangle (TriangleAlpha::Blend), which prepare_row() has made
+  /// ready: kept in the pixel's own transparent list, apart from the opaque fragments, and
+  /// composited in depth order at the resolve (abuffer_transparency.cpp).
+  void add_transparent(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
+                       double centre_z);
   /// Resolves every pixel and writes the tile into the frame.
   void resolve(const FrameTarget& target);
 
@@ -123,6 +128,21 @@ class ABufferTile {
   std::uint64_t overflow_count() const { return overflows_; }
 
  private:
+  /// What the transparent fragments in front leave of each opaque contributor of a pixel
+  /// (a triangle, or null for the background): the mean transmittance over the samples where
+  /// it is the nearest opaque surface; `fallback` (the pixel's mean) for one that owns none.
+  struct Transmittance {
+    int n = 0;
+    const TriangleSetup* who[kMaskSamples + 1];
+    double keep[kMaskSamples + 1];
+    double fallback = 1.0;
+    double of(const TriangleSetup* t) const {
+      for (int k = 0; k < n; ++k) {
+        if (who[k] == t) return keep[k];
+      }
+      return fallback;
+    }
+  };
   /// One triangle's piece of a pixel: 16 bytes, so a tile's lists stay in cache.
   struct Fragment {
     const TriangleSetup* triangle;  ///< when merged: the piece whose plane stands for all
@@ -203,7 +223,8 @@ class ABufferTile {
   /// Lowers the pixel's occluder_z_ to (just behind) its farthest sample depth.
   void bound_by_samples(std::size_t pixel);
   /// A sampled pixel's colour: the mean of its samples' winners' colours (and its depth).
-  glm::vec3 resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
+  glm::vec3 resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background, float& depth,
+                            const Transmittance* tr = nullptr);
   /// Merges triangle `t`'s piece (coverage, sample mask, colour at the pixel centre) into
   /// fragment `f`, which has room for another piece.
   void merge_into(std::uint32_t f, const TriangleSetup& t, std::uint32_t coverage, int x, int y);
@@ -229,7 +250,25 @@ class ABufferTile {
   /// Writes the pixels `r` that show `opaque` (null: the background) alone into the frame.
   void resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
                             const FrameTarget& target);
-  glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth);
+  /// With `tr`, every opaque contributor's weight is multiplied by tr->of(contributor): the
+  /// opaque part of a pixel behind transparent fragments (null: the opaque resolve as is).
+  glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth,
+                          const Transmittance* tr = nullptr);
+  /// A pixel with transparent fragments: the opaque resolve seen through them plus their own
+  /// weighted colours (abuffer_transparency.cpp).
+  glm::vec3 resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,
+                                float& depth);
+  /// The common case of resolve_transparent: every transparent fragment covers the pixel,
+  /// lies in front of every opaque contributor all over it, and no two of them cross there.
+  /// Then `transmit` = prod (1 - alpha_j) and `light` = sum_j alpha_j c_j prod_{i < j} (1 -
+  /// alpha_i), nearest first; false otherwise.
+  bool uniform_transparency(std::size_t pixel, int x, int y, double& transmit,
+                            glm::dvec3& light) const;
+  /// The pixel's opaque resolve with each contributor weighted by tr.of(contributor).
+  glm::vec3 opaque_through(std::size_t pixel, int x, int y, glm::vec3 background, float& depth,
+                           const Transmittance& tr);
+  /// Per sample of a pixel, the nearest opaque depth and its triangle (null: background).
+  void opaque_samples(std::size_t pixel, int x, int y, double* z, const TriangleSetup** id) const;
 
   int stride_;
   int capacity_;  ///< fragments per pixel before the overflow policy, <= kMaxFragmentsPerPixel
@@ -296,6 +335,12 @@ class ABufferTile {
     std::uint16_t winner_owned[kMaskSamples];
   };
   std::vector<PixelSamples> samples_;
+  /// Transparent fragments (BLEND triangles), per pixel a list apart from the opaque ones;
+  /// transparent_head_ is valid only while any_transparent_ (set by the tile's first one),
+  /// so an opaque tile never touches it.
+  std::vector<Fragment> transparent_pool_;
+  std::vector<std::uint32_t> transparent_head_;
+  bool any_transparent_ = false;
   std::vector<glm::vec3> color_;  ///< resolved linear colour
   std::vector<float> depth_;      ///< resolved window depth
   std::uint64_t overflows_ = 0;

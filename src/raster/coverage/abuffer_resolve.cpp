@@ -153,10 +153,13 @@ glm::vec3 ABufferTile::front_layer_color(const LayerSums& sums, glm::vec3 behind
 }
 
 glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
-                                     float& depth) {
+                                     float& depth, const Transmittance* tr) {
   const double cx = x + 0.5, cy = y + 0.5;
   const TriangleSetup* opaque = opaque_[pixel];
-  const glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
+  glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
+  // Seen through transparent fragments: each opaque contributor times what they leave of it.
+  if (tr != nullptr) behind *= float(tr->of(opaque));
+  const auto keep = [tr](const TriangleSetup* t) { return tr != nullptr ? tr->of(t) : 1.0; };
   if (head_[pixel] == kEnd) return behind;
 
   const DepthRange opaque_range =
@@ -208,10 +211,11 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     for (int i = 0; i < n; ++i) {
       if (member != nullptr && !member[i]) continue;
       const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+      const double w = double(cov[i]) * keep(tri[i]);
       sums.coverage += cov[i];
-      sums.rgb[0] += double(cov[i]) * c.r;
-      sums.rgb[1] += double(cov[i]) * c.g;
-      sums.rgb[2] += double(cov[i]) * c.b;
+      sums.rgb[0] += w * c.r;
+      sums.rgb[1] += w * c.g;
+      sums.rgb[2] += w * c.b;
     }
     return front_layer_color(sums, behind);
   };
@@ -259,7 +263,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   for (int i = 0; i < n; ++i) {
     if (weight[i] == 0) continue;
     const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
-    double w = weight[i] * scale;
+    double w = weight[i] * scale * keep(tri[i]);
     r += w * c.r;
     g += w * c.g;
     b += w * c.b;
@@ -323,6 +327,13 @@ void ABufferTile::resolve(const FrameTarget& target) {
       for (int y = br.y0; y < br.y1; ++y) {
         for (int x = br.x0; x < br.x1; ++x) {
           const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+          if (any_transparent_ && transparent_head_[pixel] != kEnd) {
+            // Transparent fragments: none of the one-layer shortcuts (they assume nothing
+            // in front of the opaque resolve).
+            color_[pixel] =
+                resolve_transparent(pixel, x, y, target.background_linear, depth_[pixel]);
+            continue;
+          }
           if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
             // One layer over the background: what resolve_pixel's first branch gives.
             const LayerSums& sums = layer_sums_[pixel];

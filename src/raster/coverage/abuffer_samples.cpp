@@ -95,7 +95,7 @@ bool ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const Triangle
 }
 
 glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec3 background,
-                                       float& depth) {
+                                       float& depth, const Transmittance* tr) {
   // Each triangle that won samples shows over its exact area times the share of its own
   // samples that it won (as sample_weights weighs fragments), and the background over its
   // share of the samples. A piece too thin to own a sample drops out, so the triangles'
@@ -136,11 +136,12 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
   }
   const double background_share = double(background_won) / kMaskSamples;
   const double scale = total > 0.0 ? (1.0 - background_share) / total : 0.0;
+  if (tr != nullptr) background *= float(tr->of(nullptr));
   double r = background_share * background.r, g = background_share * background.g,
          b = background_share * background.b;
   for (int k = 0; k < winners; ++k) {
     const glm::vec3 c = shade(*winner[k], x + 0.5, y + 0.5, true);
-    const double w = weight[k] * scale;
+    const double w = weight[k] * scale * (tr != nullptr ? tr->of(winner[k]) : 1.0);
     r += w * c.r;
     g += w * c.g;
     b += w * c.b;

@@ -59,11 +59,13 @@ class CoverageRasterizer final : public TileRasterizer {
       // A copy of the triangle drawn just before (same vertices and depth plane) is level
       // with it everywhere and later, so it shows nowhere: duplicate faces of CAD exports
       // and stacked copies cost one comparison each.
+      // Only an opaque one hides the copy (a MASK or BLEND one may let it show).
       if (previous_ != nullptr && same_geometry(*previous_, t)) return;
-      previous_ = &t;
+      if (t.alpha_mode == TriangleAlpha::Opaque) previous_ = &t;
     }
     bool skip_decided = false;
-    if (!blend_ && fast_paths_) {
+    // The tile and block paths assume an opaque triangle covering the pixels entirely.
+    if (!blend_ && fast_paths_ && t.alpha_mode == TriangleAlpha::Opaque) {
       if (abuffer_.add_covering_tile(t, r)) return;
       // Only a triangle at least a block wide and high can cover a whole block.
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
@@ -125,6 +127,10 @@ class CoverageRasterizer final : public TileRasterizer {
         const int lane = std::countr_zero(covered);
         const std::uint32_t coverage = row[lane];
         const int x = g + lane;
+        if (t.alpha_mode != TriangleAlpha::Opaque) {
+          alpha_fragment(t, x, y, coverage, column_z[lane] + row_z);
+          continue;
+        }
         if (!blend_) {
           abuffer_.add(x, y, &t, coverage, column_z[lane] + row_z);
           continue;
@@ -140,6 +146,35 @@ class CoverageRasterizer final : public TileRasterizer {
         depth_[i] = z;
       }
     }
+  }
+
+  /// A fragment of a MASK or BLEND triangle. MASK: kept where the alpha at the shading point
+  /// (the pixel centre clamped into the triangle) is >= the cutoff, then opaque. BLEND:
+  /// coverage mode keeps it in the A-buffer's transparent list; coverage-blend (the seed)
+  /// blends it over the frame buffer in draw order with alpha8 x alpha and does not write
+  /// the depth, as a GPU would.
+  void alpha_fragment(const TriangleSetup& t, int x, int y, std::uint32_t coverage,
+                      double centre_z) {
+    const double cx = x + 0.5, cy = y + 0.5;
+    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps(t, cx, cy, true)) return;
+    if (!blend_) {
+      if (t.alpha_mode == TriangleAlpha::Blend) {
+        abuffer_.add_transparent(x, y, &t, coverage, centre_z);
+      } else {
+        abuffer_.add(x, y, &t, coverage, centre_z);
+      }
+      return;
+    }
+    const std::size_t i = std::size_t(y - rect_.y0) * tile_px_ + (x - rect_.x0);
+    const float z = float(t.depth_at(cx, cy));
+    if (!(z < depth_[i])) return;
+    const ShadedColor c = shade_rgba(t, cx, cy, true);
+    const float alpha =
+        coverage_to_alpha8(coverage) / 255.0f *
+        (t.alpha_mode == TriangleAlpha::Blend ? float(std::clamp(c.alpha, 0.0, 1.0)) : 1.0f);
+    const glm::vec3 dst = color_[i].r < 0.0f ? background_ : color_[i];
+    color_[i] = alpha * c.rgb + (1.0f - alpha) * dst;
+    if (t.alpha_mode == TriangleAlpha::Mask) depth_[i] = z;
   }
 
   static bool same_geometry(const TriangleSetup& a, const TriangleSetup& b) {

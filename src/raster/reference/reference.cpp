@@ -99,9 +99,21 @@ void ReferenceRasterizer::resolve_tile(const FrameTarget&) {
       }
       std::fill(depth_.begin(), depth_.end(), std::numeric_limits<double>::infinity());
       std::fill(winner_.begin(), winner_.end(), kNoTriangle);
+      blend_.clear();
       for (std::uint32_t k = row_begin_[row]; k < row_begin_[row + 1]; ++k) {
         const Pending& p = pending_[row_items_[k]];
-        if (x >= p.rect.x0 && x < p.rect.x1) sample_pixel(*p.triangle, row_items_[k], x, y);
+        if (x < p.rect.x0 || x >= p.rect.x1) continue;
+        if (p.triangle->alpha_mode == TriangleAlpha::Blend) {
+          blend_.push_back(row_items_[k]);  // composited after the opaque samples
+        } else {
+          sample_pixel(*p.triangle, row_items_[k], x, y);
+        }
+      }
+      if (!blend_.empty()) {
+        double nearest = std::numeric_limits<double>::infinity();
+        linear_[i] = composite_pixel(x, y, nearest);
+        pixel_depth_[i] = float(nearest);
+        continue;
       }
       // Box filter in double; each sample shaded at its own position. A flat triangle
       // shades the same everywhere, so its samples are counted and weighted once.
@@ -134,7 +146,74 @@ void ReferenceRasterizer::resolve_tile(const FrameTarget&) {
   }
 }
 
+glm::dvec3 ReferenceRasterizer::composite_pixel(int x, int y, double& nearest) {
+  const std::size_t count = ox_.size();
+  const std::size_t layers = blend_.size();
+  // Per transparent triangle and sample: its depth where it covers the sample in front of the
+  // nearest opaque one, else +inf.
+  layer_z_.assign(layers * count, std::numeric_limits<double>::infinity());
+  for (std::size_t b = 0; b < layers; ++b) {
+    const TriangleSetup& t = *pending_[blend_[b]].triangle;
+    if (!inside_samples(t, x, y)) continue;
+    const double z0 = t.depth_at(x, y);
+    for (std::size_t s = 0; s < count; ++s) {
+      const double z = z0 + (t.dzdx * ox_[s] + t.dzdy * oy_[s]);
+      if (inside_[s] != 0 && z < depth_[s]) layer_z_[b * count + s] = z;
+    }
+  }
+  glm::dvec3 sum(0.0);
+  std::vector<std::pair<double, std::size_t>> stack;
+  for (std::size_t s = 0; s < count; ++s) {
+    const double sx = x + ox_[s], sy = y + oy_[s];
+    glm::dvec3 behind = background_;
+    if (const std::uint32_t w = winner_[s]; w != kNoTriangle) {
+      nearest = std::min(nearest, depth_[s]);
+      behind = glm::dvec3(shade(*pending_[w].triangle, sx, sy, false));
+    }
+    stack.clear();
+    for (std::size_t b = 0; b < layers; ++b) {
+      if (layer_z_[b * count + s] < std::numeric_limits<double>::infinity()) {
+        stack.emplace_back(layer_z_[b * count + s], b);
+      }
+    }
+    // Nearest first; level ones in draw order (the lower primitive index in front).
+    std::sort(stack.begin(), stack.end(), [&](const auto& a, const auto& b) {
+      return a.first < b.first ||
+             (a.first == b.first && pending_[blend_[a.second]].triangle->primitive <
+                                        pending_[blend_[b.second]].triangle->primitive);
+    });
+    glm::dvec3 c(0.0);
+    double transmit = 1.0;
+    for (const auto& layer : stack) {
+      const ShadedColor sc = shade_rgba(*pending_[blend_[layer.second]].triangle, sx, sy, false);
+      const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
+      c += transmit * alpha * glm::dvec3(sc.rgb);
+      transmit *= 1.0 - alpha;
+    }
+    sum += c + transmit * behind;
+  }
+  return sum / double(count);
+}
+
 void ReferenceRasterizer::sample_pixel(const TriangleSetup& t, std::uint32_t index, int x, int y) {
+  if (!inside_samples(t, x, y)) return;
+  const std::size_t count = ox_.size();
+  if (t.alpha_mode == TriangleAlpha::Mask) {
+    // Kept where the alpha at the sample passes the cutoff (a texture-driven edge, per sample).
+    for (std::size_t s = 0; s < count; ++s) {
+      if (inside_[s] != 0) inside_[s] = mask_keeps(t, x + ox_[s], y + oy_[s], false);
+    }
+  }
+  const double z0 = t.depth_at(x, y);
+  for (std::size_t s = 0; s < count; ++s) {
+    const double z = z0 + (t.dzdx * ox_[s] + t.dzdy * oy_[s]);
+    const bool wins = inside_[s] != 0 && z < depth_[s];
+    depth_[s] = wins ? z : depth_[s];
+    winner_[s] = wins ? index : winner_[s];
+  }
+}
+
+bool ReferenceRasterizer::inside_samples(const TriangleSetup& t, int x, int y) {
   const TriangleEdges edges(t);
   constexpr double kFx8Squared = 1.0 / (double(kSubpixelOne) * kSubpixelOne);
   double e0[3], dx[3], dy[3];
@@ -154,10 +233,9 @@ void ReferenceRasterizer::sample_pixel(const TriangleSetup& t, std::uint32_t ind
     // keeps its sign, so these tests are exact too.
     const double c_min = std::min(0.0, dx[e]) + std::min(0.0, -dy[e]);
     const double c_max = std::max(0.0, dx[e]) + std::max(0.0, -dy[e]);
-    if (e0[e] + c_max < 0.0) return;  // no sample inside this edge
+    if (e0[e] + c_max < 0.0) return false;  // no sample inside this edge
     if (!(e0[e] + c_min > 0.0)) partial[partial_count++] = e;
   }
-  const double z0 = t.depth_at(x, y);
   const std::size_t count = ox_.size();
   // Branch-free passes (the compiler vectorises them): the edges first, then depth.
   std::fill(inside_.begin(), inside_.end(), std::uint8_t(1));
@@ -170,12 +248,7 @@ void ReferenceRasterizer::sample_pixel(const TriangleSetup& t, std::uint32_t ind
       for (std::size_t s = 0; s < count; ++s) inside_[s] &= a + (ex * oy_[s] - ey * ox_[s]) > 0.0;
     }
   }
-  for (std::size_t s = 0; s < count; ++s) {
-    const double z = z0 + (t.dzdx * ox_[s] + t.dzdy * oy_[s]);
-    const bool wins = inside_[s] != 0 && z < depth_[s];
-    depth_[s] = wins ? z : depth_[s];
-    winner_[s] = wins ? index : winner_[s];
-  }
+  return true;
 }
 
 std::unique_ptr<TileRasterizer> make_reference_rasterizer(int tile_px) {

@@ -43,7 +43,14 @@ class ReferenceRasterizer final : public TileRasterizer {
     const TriangleSetup* triangle;
     PixelRect rect;
   };
+  /// Depth-tests an opaque or MASK triangle at pixel (x, y)'s samples.
   void sample_pixel(const TriangleSetup& t, std::uint32_t index, int x, int y);
+  /// inside_[s]: sample s of pixel (x, y) lies in `t` (top-left rule); false when none can.
+  bool inside_samples(const TriangleSetup& t, int x, int y);
+  /// Pixel (x, y) with BLEND triangles (blend_): per sample, the ones in front of the nearest
+  /// opaque sample composited front to back over it (docs/transparency.md); the box filter of
+  /// that, and the nearest opaque depth in `nearest`.
+  glm::dvec3 composite_pixel(int x, int y, double& nearest);
 
   int tile_px_;
   std::vector<double> ox_;  ///< sample offsets from the pixel corner [pixels]
@@ -54,6 +61,8 @@ class ReferenceRasterizer final : public TileRasterizer {
   std::vector<std::uint32_t> flat_count_;  ///< resolve: samples won per flat triangle
   std::vector<std::uint32_t> touched_;     ///< resolve: flat triangles in order of first win
   std::vector<Pending> pending_;
+  std::vector<std::uint32_t> blend_;  ///< the current pixel's BLEND triangles (pending_ index)
+  std::vector<double> layer_z_;       ///< composite_pixel: per BLEND triangle and sample
   std::vector<std::uint32_t> row_begin_;
   std::vector<std::uint32_t> row_items_;
   std::vector<std::uint32_t> row_cursor_;

@@ -131,12 +131,17 @@ void SampleRasterizer::begin_tile(const PixelRect& rect, const FrameTarget& targ
   background_q_[2] = quantize_color(target.background_linear.b);
   immediate_ = rect.y1 - rect.y0 <= band_rows_;
   pending_.clear();
+  blend_.clear();
   if (immediate_) start_band(rect.y0, rect.y1);
 }
 
 void SampleRasterizer::draw(const TriangleSetup& t) {
   const PixelRect r = intersect(touched_pixels(t), rect_);
   if (r.empty()) return;
+  if (t.alpha_mode == TriangleAlpha::Blend) {
+    blend_.push_back(Pending{&t, r});  // composited per sample before the resolve
+    return;
+  }
   if (immediate_) {
     rasterize(t, r);
   } else {
@@ -222,7 +227,9 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
     flat_rgb = rgb;
   }
   const std::size_t stride = std::size_t(gp.stride);
-  if (fits) {
+  // MASK triangles take the int64 path on every group: it tests the alpha sample by sample.
+  const bool mask = t.alpha_mode == TriangleAlpha::Mask;
+  if (fits && !mask) {
     job.rgb = flat_rgb;
     ShadeContext context{this, &t};
     job.shade_fn = &SampleRasterizer::shade_trampoline;
@@ -264,11 +271,11 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
       std::uint64_t written[kMaxGroupLanes / 64] = {0, 0, 0, 0};
       std::uint64_t* written_ptr = flat_rgb != nullptr ? nullptr : written;
       bool any;
-      if (all_inside) {
+      if (all_inside && !mask) {
         any = kernels_.sample(gp, *tri_, nullptr, z_base, flat_rgb, out, written_ptr);
       } else {
         any = false;
-        sample_wide(t, f_here, z_base, flat_rgb, out, written);
+        sample_wide(t, f_here, z_base, flat_rgb, out, written, gx, y);
         for (std::uint64_t w : written) any |= w != 0;
       }
       if (any && flat_rgb == nullptr) shade_written(t, gx, y, written, out);
@@ -279,7 +286,7 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
 
 void SampleRasterizer::sample_wide(const TriangleSetup& t, const std::int64_t f[3], float z_base,
                                    const std::uint32_t* rgb, const GroupSamples& out,
-                                   std::uint64_t* written) {
+                                   std::uint64_t* written, int gx, int y) {
   // The int64 twin of the kernel for triangles with an edge too long for int32 lanes;
   // it only runs on partly covered groups, i.e. along such a triangle's edges.
   const GroupPattern& gp = *pattern_;
@@ -293,6 +300,7 @@ void SampleRasterizer::sample_wide(const TriangleSetup& t, const std::int64_t f[
     }
     const float z = z_base + tri_->dz[l];
     if (!inside || !(z < out.depth[l])) continue;
+    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps_lane(t, gx, y, l)) continue;
     out.depth[l] = z;
     if (rgb != nullptr) {
       out.r[l] = rgb[0];
@@ -300,6 +308,79 @@ void SampleRasterizer::sample_wide(const TriangleSetup& t, const std::int64_t f[
       out.b[l] = rgb[2];
     }
     written[l / 64] |= std::uint64_t(1) << (l % 64);
+  }
+}
+
+bool SampleRasterizer::mask_keeps_lane(const TriangleSetup& t, int gx, int y, int l) const {
+  const GroupPattern& gp = *pattern_;
+  if (rate_ == ShadingRate::PerPixel) {
+    // msaa: the alpha of the pixel's one shading point, the centre clamped into the triangle.
+    return mask_keeps(t, gx + l / gp.stride + 0.5, y + 0.5, true);
+  }
+  return mask_keeps(t, gx + gp.ox_fx8[l] * (1.0 / kSubpixelOne),
+                    y + gp.oy_fx8[l] * (1.0 / kSubpixelOne), false);
+}
+
+void SampleRasterizer::composite_band() {
+  // Per sample of every pixel that a BLEND triangle touches: the BLEND triangles covering it
+  // in front of its opaque depth, nearest first (level ones by primitive index), composited
+  // over its colour, or the background's (docs/transparency.md). A sample that only BLEND
+  // triangles cover gets the largest finite depth, so that the resolve reads its colour; the
+  // pixel depth output clamps it to 1, as the background's.
+  const GroupPattern& gp = *pattern_;
+  const double inv = 1.0 / kSubpixelOne;
+  std::vector<const Pending*> layers;
+  std::vector<std::pair<float, const TriangleSetup*>> stack;
+  for (int y = band_y0_; y < band_y1_; ++y) {
+    for (int x = rect_.x0; x < rect_.x1; ++x) {
+      layers.clear();
+      for (const Pending& p : blend_) {
+        if (x >= p.rect.x0 && x < p.rect.x1 && y >= p.rect.y0 && y < p.rect.y1) {
+          layers.push_back(&p);
+        }
+      }
+      if (layers.empty()) continue;
+      const int gx = floor_div(x, gp.group_px) * gp.group_px;
+      const int first = (x - gx) * gp.stride;
+      const std::size_t base =
+          (std::size_t(y - band_y0_) * std::size_t(buffer_px_) + std::size_t(gx - buffer_x0_)) *
+          std::size_t(gp.stride);
+      for (int l = first; l < first + gp.samples; ++l) {
+        const std::int64_t sx = std::int64_t(gx) * kSubpixelOne + gp.ox_fx8[l];
+        const std::int64_t sy = std::int64_t(y) * kSubpixelOne + gp.oy_fx8[l];
+        float& depth = depth_[base + std::size_t(l)];
+        stack.clear();
+        for (const Pending* p : layers) {
+          const TriangleEdges edges(*p->triangle);
+          if ((edges.e[0].at(sx, sy) | edges.e[1].at(sx, sy) | edges.e[2].at(sx, sy)) < 0) continue;
+          const float z = float(p->triangle->depth_at(sx * inv, sy * inv));
+          if (z < depth) stack.emplace_back(z, p->triangle);
+        }
+        if (stack.empty()) continue;
+        std::sort(stack.begin(), stack.end(), [](const auto& a, const auto& b) {
+          return a.first < b.first ||
+                 (a.first == b.first && a.second->primitive < b.second->primitive);
+        });
+        std::uint32_t* rgb[3] = {&r_[base + std::size_t(l)], &g_[base + std::size_t(l)],
+                                 &b_[base + std::size_t(l)]};
+        const bool empty = !(depth < std::numeric_limits<float>::infinity());
+        glm::dvec3 c(0.0);
+        double transmit = 1.0;
+        for (const auto& layer : stack) {
+          const ShadedColor sc = rate_ == ShadingRate::PerPixel
+                                     ? shade_rgba(*layer.second, x + 0.5, y + 0.5, true)
+                                     : shade_rgba(*layer.second, sx * inv, sy * inv, false);
+          const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
+          c += transmit * alpha * glm::dvec3(sc.rgb);
+          transmit *= 1.0 - alpha;
+        }
+        for (int k = 0; k < 3; ++k) {
+          const double behind = (empty ? background_q_[k] : *rgb[k]) / kColorOne;
+          *rgb[k] = quantize_color(float(c[k] + transmit * behind));
+        }
+        if (empty) depth = std::numeric_limits<float>::max();
+      }
+    }
   }
 }
 
@@ -344,6 +425,7 @@ void SampleRasterizer::shade_written(const TriangleSetup& t, int gx, int y,
 }
 
 void SampleRasterizer::resolve_band() {
+  if (!blend_.empty()) composite_band();
   const GroupPattern& gp = *pattern_;
   const int pixels = rect_.x1 - rect_.x0;
   const double scale = 1.0 / (double(gp.samples) * kColorOne);  // exact for S = 2^k

@@ -67,8 +67,15 @@ class SampleRasterizer final : public TileRasterizer {
                                const GroupSamples& group);
   void start_band(int y0, int y1);
   void rasterize(const TriangleSetup& t, const PixelRect& r);
+  /// (gx, y): the group's first pixel, for the alpha test of MASK triangles.
   void sample_wide(const TriangleSetup& t, const std::int64_t f[3], float z_base,
-                   const std::uint32_t* rgb, const GroupSamples& out, std::uint64_t* written);
+                   const std::uint32_t* rgb, const GroupSamples& out, std::uint64_t* written,
+                   int gx, int y);
+  /// Whether MASK triangle `t` keeps lane l of the group at (gx, y): its alpha at the lane's
+  /// shading point (ssaa: the sample; msaa: the pixel centre clamped into t) >= the cutoff.
+  bool mask_keeps_lane(const TriangleSetup& t, int gx, int y, int l) const;
+  /// Composites the tile's BLEND triangles into the band's samples (before the resolve).
+  void composite_band();
   void shade_written(const TriangleSetup& t, int gx, int y, const std::uint64_t* written,
                      const GroupSamples& out);
   void resolve_band();
@@ -89,6 +96,7 @@ class SampleRasterizer final : public TileRasterizer {
   std::vector<glm::vec3> linear_;
   std::vector<float> pixel_depth_;
   std::vector<Pending> pending_;
+  std::vector<Pending> blend_;       ///< the tile's BLEND triangles, in draw order
   double deferred_raster_ms_ = 0.0;  ///< replaying pending_ in end_tile, summed over tiles
   std::vector<std::uint32_t> band_begin_;
   std::vector<std::uint32_t> band_items_;
