@@ -10,6 +10,7 @@
 // through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
+#include "scene/gltf_input.hpp"
 #include "scene/gltf_pose.hpp"
 #include "scene/scene_internal.hpp"
 
@@ -193,15 +194,16 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
 
 /// The file as tinygltf reads it (images accepted without decoding); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
-                           const std::filesystem::path& base_dir) {
+                           const std::filesystem::path& base_dir, std::string& warn) {
+  check_gltf_input(bytes, name, base_dir);
   const std::optional<std::string> rewritten = without_draco_indices(bytes);
   if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&skip_image, nullptr);
+  loader.SetFsCallbacks(gltf_fs_callbacks());
   tinygltf::Model model;
   std::string err;
-  std::string warn;
   const bool ok =
       is_glb(bytes)
           ? loader.LoadBinaryFromMemory(&model, &err, &warn,
@@ -366,6 +368,8 @@ class GltfMeshBuilder {
     const std::vector<std::uint32_t> corners = triangle_corners(
         mode, vertex_sequence(source, what, vertex_count), primitive.indices >= 0, what);
     const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count);
+    check_copies(placement.skin_joints.empty() ? placement.worlds.size() : 1, vertex_count,
+                 corners.size() / 3, what);
     const std::uint32_t material = primitive.material >= 0
                                        ? static_cast<std::uint32_t>(primitive.material)
                                        : default_material_;
@@ -378,6 +382,21 @@ class GltfMeshBuilder {
           vertex_skin_matrices(skin_influences(source, vertices.count(), what), vertices.count(),
                                placement.skin_joints, name_, what);
       place(skinned(vertices, skin), corners, colors, material, glm::dmat4(1.0));
+    }
+  }
+
+  /// Before `copies` placed copies of a primitive are made: the file's vertices stay within
+  /// 32-bit indices and its triangles within kMaxSceneTriangles (instancing multiplies both).
+  void check_copies(std::size_t copies, std::size_t vertex_count, std::size_t triangle_count,
+                    const std::string& what) const {
+    const std::uint64_t vertices = std::uint64_t(copies) * vertex_count;
+    const std::uint64_t triangles = std::uint64_t(copies) * triangle_count;
+    if (vertices > kMaxVertices - mesh_->positions.size()) {
+      fail(name_, what + ": more than " + std::to_string(kMaxVertices) + " vertices in all");
+    }
+    if (triangles > kMaxSceneTriangles - mesh_->triangle_count()) {
+      fail(name_, what + ": " + std::to_string(copies) + " copies make more than " +
+                      std::to_string(kMaxSceneTriangles) + " triangles (docs/limits.md)");
     }
   }
 
@@ -766,12 +785,15 @@ class GltfMeshBuilder {
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                       const std::filesystem::path& base_dir) {
-  const tinygltf::Model model = read_model(bytes, display_name, base_dir);
+  std::string warn;
+  const tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);
   const std::vector<int> roots = root_nodes(model, display_name);
   GltfMeshBuilder builder(model, display_name);
   builder.add_node_trees(roots);
-  return builder.finish();
+  LoadedMesh loaded = builder.finish();
+  add_loader_warnings(warn, display_name, loaded.warnings);
+  return loaded;
 }
 
 }  // namespace covrast::detail
