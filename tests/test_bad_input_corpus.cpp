@@ -397,6 +397,17 @@ std::vector<Case> scene_cases() {
       scene_case("scene: lights object",
                  scene_text(R"([{"obj":"m.obj"}])", kCamera, R"(,"lights":{"type":"point"})"),
                  "s.json: lights: expected an array"),
+      scene_case("scene: too many lights",
+                 scene_text(R"([{"obj":"m.obj"}])", kCamera,
+                            [] {
+                              std::string lights = R"(,"lights":[)";
+                              for (std::uint64_t i = 0; i <= covrast::kMaxSceneLights; ++i) {
+                                lights += i == 0 ? "" : ",";
+                                lights += R"({"type":"ambient"})";
+                              }
+                              return lights + "]";
+                            }()),
+                 "s.json: lights: 1025 lights, more than 1024 (docs/limits.md)"),
       scene_case("scene: light type",
                  scene_text(R"([{"obj":"m.obj"}])", kCamera, R"(,"lights":[{"type":"laser"}])"),
                  "s.json: lights[0].type: expected"),

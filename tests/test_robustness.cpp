@@ -153,6 +153,29 @@ TEST_CASE("robust: a scene that draws more than kMaxSceneTriangles is refused", 
   CHECK(covrast::load_scene(dir / "s.json").triangle_count() == 32u << 20);
 }
 
+TEST_CASE("robust: a glTF file whose instances make more than kMaxSceneTriangles is refused",
+          "[robust]") {
+  TempDir dir("covrast-robust");
+  // 2^20 triangles (zeros, no file bytes), instanced 33 times by EXT_mesh_gpu_instancing:
+  // refused before the first copy is made.
+  GltfBuilder builder;
+  builder.gltf["accessors"] = {{{"componentType", 5126}, {"count", 3 << 20}, {"type", "VEC3"}},
+                               {{"componentType", 5126}, {"count", 33}, {"type", "VEC3"}}};
+  builder.single_mesh({{{"attributes", {{"POSITION", 0}}}}});
+  builder.gltf["nodes"][0]["extensions"] = {
+      {"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", 1}}}}}};
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  const auto start = std::chrono::steady_clock::now();
+  CHECK(load_error([&] { covrast::load_mesh(dir / "m.gltf"); }) ==
+        (dir / "m.gltf").string() +
+            ": mesh 0 primitive 0: 33 copies make more than 33554432 triangles (docs/limits.md)");
+  CHECK(seconds_since(start) < 10.0);
+  // 2 copies load (2 * 2^20 triangles).
+  builder.gltf["accessors"][1]["count"] = 2;
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  CHECK(covrast::load_mesh(dir / "m.gltf")->triangle_count() == 2u << 20);
+}
+
 TEST_CASE("robust: a glTF accessor over the element limit is refused before allocating",
           "[robust]") {
   TempDir dir("covrast-robust");

@@ -37,6 +37,8 @@ inline constexpr std::uint64_t kMaxSceneTriangles = std::uint64_t(1) << 25;
 inline constexpr std::uint64_t kMaxAccessorElements = std::uint64_t(1) << 24;
 /// Most instances one EXT_mesh_gpu_instancing node may make of its mesh.
 inline constexpr std::uint64_t kMaxGltfInstances = std::uint64_t(1) << 20;
+/// Most lights of one scene file: each is evaluated at every shaded pixel or sample.
+inline constexpr std::uint64_t kMaxSceneLights = 1024;
 /// Most corners of one OBJ face (polygons become triangle fans).
 inline constexpr std::uint64_t kMaxObjFaceCorners = std::uint64_t(1) << 16;
 

@@ -321,6 +321,11 @@ class SceneReader {
 
   std::vector<Light> lights(const json& value) const {
     if (!value.is_array()) fail(file_, "lights", "expected an array, got " + shown(value));
+    if (value.size() > kMaxSceneLights) {
+      fail(file_, "lights",
+           std::to_string(value.size()) + " lights, more than " + std::to_string(kMaxSceneLights) +
+               " (docs/limits.md)");
+    }
     std::vector<Light> result;
     for (std::size_t i = 0; i < value.size(); ++i) {
       result.push_back(light(value[i], "lights[" + std::to_string(i) + "]"));
