@@ -22,6 +22,27 @@ namespace covrast {
 /// Largest accepted image side [pixels]. Larger requests are refused as bad input.
 inline constexpr int kMaxImageSide = 16384;
 
+/// Input limits (docs/limits.md): a file over one of them is refused with an InputError
+/// naming it, before anything is allocated for its content.
+/// Largest mesh file or glTF buffer/image file read [bytes] (1 GiB).
+inline constexpr std::uint64_t kMaxInputFileBytes = std::uint64_t(1) << 30;
+/// Largest scene file [bytes] (64 MiB).
+inline constexpr std::uint64_t kMaxSceneFileBytes = std::uint64_t(1) << 26;
+/// Deepest nesting of arrays and objects in a scene file or a glTF JSON chunk: deeper
+/// values would make the parsers and the message printer recurse without bound.
+inline constexpr int kMaxJsonDepth = 128;
+/// Most triangles one scene may draw, summed over its instances (and over the copies a glTF
+/// file makes of its meshes: nodes, EXT_mesh_gpu_instancing).
+inline constexpr std::uint64_t kMaxSceneTriangles = std::uint64_t(1) << 25;
+/// Most elements one glTF accessor may hold (vertices, indices, instances).
+inline constexpr std::uint64_t kMaxAccessorElements = std::uint64_t(1) << 24;
+/// Most instances one EXT_mesh_gpu_instancing node may make of its mesh.
+inline constexpr std::uint64_t kMaxGltfInstances = std::uint64_t(1) << 20;
+/// Most lights of one scene file: each is evaluated at every shaded pixel or sample.
+inline constexpr std::uint64_t kMaxSceneLights = 1024;
+/// Most corners of one OBJ face (polygons become triangle fans).
+inline constexpr std::uint64_t kMaxObjFaceCorners = std::uint64_t(1) << 16;
+
 /// OpenGL conventions: view = lookAt(eye, target, up), projection =
 /// perspective(fovy, width / height of the output image, near, far), clip z in [-w, w].
 struct Camera {

@@ -4,6 +4,7 @@
 #include "commands.hpp"
 
 #include <covrast/compare.hpp>
+#include <covrast/error.hpp>
 #include <covrast/image.hpp>
 
 #include <iostream>
@@ -43,6 +44,12 @@ int run_compare(const CompareArgs& args) {
   if (!args.heatmap.empty()) check_output_path(args.heatmap, {".png"});
   const Image a = read_png(args.image_a);
   const Image b = read_png(args.image_b);
+  if (a.width != b.width || a.height != b.height) {
+    throw InputError(args.image_a + " is " + std::to_string(a.width) + "x" +
+                     std::to_string(a.height) + " but " + args.image_b + " is " +
+                     std::to_string(b.width) + "x" + std::to_string(b.height) +
+                     ": compare needs images of the same size");
+  }
   const CompareResult result = compare_images(a, b);
 
   if (args.json) {

@@ -48,10 +48,22 @@ Json read_json(const std::filesystem::path& path) {
   }
   std::ifstream in(path, std::ios::binary);
   if (!in) throw InputError(path.string() + ": cannot read manifest");
+  // Nesting bounded while parsing: deeper values would make printing and copying recurse.
+  const Json::parser_callback_t bounded = [&path](int depth, Json::parse_event_t, Json&) {
+    if (depth > kMaxJsonDepth) {
+      throw InputError(path.string() + ": malformed manifest JSON: arrays and objects nested " +
+                       "deeper than " + std::to_string(kMaxJsonDepth) + " levels");
+    }
+    return true;
+  };
   try {
-    return Json::parse(in);
+    return Json::parse(in, bounded);
   } catch (const Json::exception& e) {
-    throw InputError(path.string() + ": malformed manifest JSON: " + e.what());
+    std::string detail = e.what();  // without nlohmann's "[json.exception.KIND.N] " prefix
+    if (detail.rfind("[json.exception.", 0) == 0 && detail.find("] ") != std::string::npos) {
+      detail.erase(0, detail.find("] ") + 2);
+    }
+    throw InputError(path.string() + ": malformed manifest JSON: " + detail);
   }
 }
 
@@ -65,6 +77,10 @@ std::string string_field(const Json& object, const char* key, const Where& where
   const Json& value = object.at(key);
   if (!value.is_string() || value.get<std::string>().empty()) {
     where.fail(key, "must be a non-empty string");
+  }
+  // "\u0000" in a path would quietly name the part before it.
+  if (value.get<std::string>().find('\0') != std::string::npos) {
+    where.fail(key, "contains a NUL byte (\\u0000)");
   }
   return value.get<std::string>();
 }

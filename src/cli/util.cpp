@@ -4,6 +4,7 @@
 #include <covrast/error.hpp>
 #include <covrast/scene.hpp>
 
+#include <fcntl.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -52,6 +53,18 @@ void check_output_path(const std::filesystem::path& path,
   if (fs::is_directory(fs::status(path, ec))) {
     throw InputError(shown + ": cannot write: is a directory");
   }
+  // Permission bits do not tell everything (root passes access(); /proc and read-only mounts
+  // refuse new files): create and remove a file beside the output, as writing will, so that a
+  // bad output path fails before rendering rather than after.
+  fs::path probe = path;
+  probe += ".probe-" + std::to_string(::getpid());
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    const std::string why = std::error_code(errno, std::generic_category()).message();
+    throw InputError(shown + ": cannot write: " + why);
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
 }
 
 /// Parses "WxH" (decimal, each side 1..kMaxImageSide).

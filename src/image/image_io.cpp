@@ -277,6 +277,11 @@ void write_png(const Image& image, const std::filesystem::path& path,
 }
 
 std::vector<PngText> read_png_text(const std::filesystem::path& path) {
+  std::error_code ec;
+  const auto status = std::filesystem::status(path, ec);
+  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
+    throw InputError(path.string() + ": cannot read PNG: not a regular file");
+  }
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) {
     throw InputError(path.string() + ": cannot read PNG: " + errno_message(errno));
@@ -321,6 +326,16 @@ Image read_png(const std::filesystem::path& path) {
   const auto fail = [&](const std::string& why) -> Image {
     throw InputError(path.string() + ": cannot read PNG: " + why);
   };
+  // libspng's words for a file cut short and for its side limit, made plain.
+  const auto reason = [](int error) -> std::string {
+    if (error == SPNG_IO_EOF || error == SPNG_EOF) {
+      return "truncated: the file ends before the image does";
+    }
+    if (error == SPNG_EUSER_WIDTH || error == SPNG_EUSER_HEIGHT) {
+      return "a side over the " + std::to_string(kMaxPngSide) + " pixels covrast reads";
+    }
+    return spng_strerror(error);
+  };
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
   if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
@@ -343,7 +358,7 @@ Image read_png(const std::filesystem::path& path) {
   spng_set_chunk_limits(ctx, kMaxPngChunkBytes, kMaxPngChunkBytes);
   spng_set_png_file(ctx, file);
   spng_ihdr ihdr{};
-  if (const int error = spng_get_ihdr(ctx, &ihdr); error != 0) return fail(spng_strerror(error));
+  if (const int error = spng_get_ihdr(ctx, &ihdr); error != 0) return fail(reason(error));
   if (std::uint64_t(ihdr.width) * ihdr.height > kMaxPngPixels) {
     return fail(std::to_string(ihdr.width) + "x" + std::to_string(ihdr.height) +
                 " is more than the " + std::to_string(kMaxPngPixels) + " pixels covrast reads");
@@ -352,7 +367,7 @@ Image read_png(const std::filesystem::path& path) {
   // tRNS dropped (not composited), 16-bit samples reduced to their high byte.
   std::size_t size = 0;
   if (const int error = spng_decoded_image_size(ctx, SPNG_FMT_RGB8, &size); error != 0) {
-    return fail(spng_strerror(error));
+    return fail(reason(error));
   }
   Image image;
   image.width = int(ihdr.width);
@@ -360,7 +375,7 @@ Image read_png(const std::filesystem::path& path) {
   image.rgb.resize(size);
   if (const int error = spng_decode_image(ctx, image.rgb.data(), size, SPNG_FMT_RGB8, 0);
       error != 0) {
-    return fail(spng_strerror(error));
+    return fail(reason(error));
   }
   return image;
 }

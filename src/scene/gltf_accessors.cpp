@@ -3,6 +3,7 @@
 #include "scene/gltf_accessors.hpp"
 
 #include <covrast/error.hpp>
+#include <covrast/scene.hpp>
 
 #include <algorithm>
 #include <bit>
@@ -13,9 +14,6 @@ namespace covrast::detail {
 namespace {
 
 static_assert(std::endian::native == std::endian::little, "glTF buffers are little-endian");
-
-/// Accessors without a bufferView are all zeros (plus sparse values): cap what they allocate.
-constexpr std::size_t kMaxUnbackedElements = std::size_t{1} << 26;
 
 int component_size_bytes(int component_type) {
   switch (component_type) {
@@ -150,11 +148,11 @@ std::vector<double> GltfReader::read_accessor(const std::string& what, int acces
     fail(name, what + ": unsupported accessor type or component type");
   }
   const auto width = static_cast<std::size_t>(components);
-  if (accessor.bufferView < 0 && accessor.count > kMaxUnbackedElements) {
-    fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
-  }
-  if (accessor.bufferView >= 0 && accessor.count > kMaxVertices) {
-    fail(name, what + ": accessor count " + std::to_string(accessor.count) + " too large");
+  // Before allocating: an accessor without a bufferView is all zeros and costs no file bytes.
+  if (accessor.count > kMaxAccessorElements) {
+    fail(name, what + ": accessor " + std::to_string(accessor_index) + " has " +
+                   std::to_string(accessor.count) + " elements, more than the " +
+                   std::to_string(kMaxAccessorElements) + " covrast reads (docs/limits.md)");
   }
   std::vector<double> values;
   if (accessor.bufferView >= 0) {

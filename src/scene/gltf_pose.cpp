@@ -1,6 +1,8 @@
 // Static-pose glTF posing (gltf_pose.hpp): morph targets, skins, EXT_mesh_gpu_instancing.
 #include "scene/gltf_pose.hpp"
 
+#include <covrast/scene.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -29,9 +31,18 @@ std::vector<double> instance_attribute(const GltfReader& reader, const tinygltf:
   if (!attributes.Has(key)) return {};
   const tinygltf::Value& accessor = attributes.Get(key);
   if (!accessor.IsInt()) fail(reader.name, what + ": " + key + " must be an accessor index");
+  // Checked before reading: each instance becomes a copy of the mesh (a matrix of 128 bytes
+  // now, and its vertices later), so the limit is far below an accessor's.
+  const int index = accessor.GetNumberAsInt();
+  if (index >= 0 && std::size_t(index) < reader.model.accessors.size() &&
+      reader.model.accessors[std::size_t(index)].count > kMaxGltfInstances) {
+    fail(reader.name, what + ": " + key + " gives " +
+                          std::to_string(reader.model.accessors[std::size_t(index)].count) +
+                          " instances, more than " + std::to_string(kMaxGltfInstances) +
+                          " (docs/limits.md)");
+  }
   int components = 0;
-  std::vector<double> values =
-      reader.read_accessor(what + " " + key, accessor.GetNumberAsInt(), components);
+  std::vector<double> values = reader.read_accessor(what + " " + key, index, components);
   if (components != width) {
     fail(reader.name, what + ": " + key + (width == 3 ? " must be VEC3" : " must be VEC4"));
   }

@@ -18,17 +18,6 @@ bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::stri
 
 namespace {
 
-bool read_regular_file(std::vector<unsigned char>* out, std::string* error, const std::string& path,
-                       void* user_data) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    if (error != nullptr) *error += path + ": not a regular file\n";
-    return false;
-  }
-  return tinygltf::ReadWholeFile(out, error, path, user_data);
-}
-
 /// A URI's %XX escapes decoded (RFC 3986, 2.1), as tinygltf decodes it before opening.
 std::string percent_decoded(const std::string& uri) {
   std::string out;
@@ -108,11 +97,6 @@ std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& pa
                                                  const std::string& name, bool srgb) {
   const RgbaImage image = read_image(path, name);
   return make_texture(name, image.width, image.height, image.rgba, srgb);
-}
-
-tinygltf::FsCallbacks regular_file_callbacks() {
-  return tinygltf::FsCallbacks{&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_regular_file,
-                               &tinygltf::WriteWholeFile, nullptr};
 }
 
 RgbaImage GltfTextures::decode(const tinygltf::Image& image, const std::string& image_name) const {

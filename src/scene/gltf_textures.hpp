@@ -24,10 +24,6 @@ namespace covrast::detail {
 bool keep_image_bytes(tinygltf::Image* image, const int image_index, std::string* error,
                       std::string* warning, int, int, const unsigned char* bytes, int size, void*);
 
-/// tinygltf's file callbacks with one change: only regular files are read (a FIFO named as a
-/// buffer or image would block the loader forever).
-tinygltf::FsCallbacks regular_file_callbacks();
-
 /// The textures of one glTF file: each image decoded and mipmapped at most once per colour
 /// space, shared by every material slot that uses it.
 class GltfTextures {

@@ -2,43 +2,71 @@
 // OBJ and glTF parsers, and the public load_mesh entry point (format chosen by extension).
 #include "scene/scene_internal.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <memory>
 #include <system_error>
 
 namespace covrast {
 namespace detail {
 
-bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec) {
-    error = ec.message();
+std::string size_text(std::uint64_t bytes) {
+  if (bytes % (std::uint64_t(1) << 30) == 0) return std::to_string(bytes >> 30) + " GiB";
+  if (bytes % (std::uint64_t(1) << 20) == 0) return std::to_string(bytes >> 20) + " MiB";
+  return std::to_string(bytes) + " bytes";
+}
+
+bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
+                     std::uint64_t max_bytes) {
+  const auto system_error = [&](int code) {
+    error = std::error_code(code, std::generic_category()).message();
+    return false;
+  };
+  // A path string with an embedded NUL would quietly open its prefix.
+  if (path.native().find('\0') != std::string::npos) {
+    error = "the path contains a NUL byte";
     return false;
   }
-  if (std::filesystem::is_directory(status)) {
-    error = std::make_error_code(std::errc::is_a_directory).message();
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat then refuses everything
+  // that is not a regular file (FIFOs, devices such as /dev/zero, directories), checked on
+  // the opened file itself so that nothing can swap it in between.
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) return system_error(errno);
+  const std::unique_ptr<int, void (*)(int*)> closer(new int(fd), [](int* f) {
+    ::close(*f);
+    delete f;
+  });
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) return system_error(errno);
+  if (S_ISDIR(info.st_mode)) return system_error(EISDIR);
+  if (!S_ISREG(info.st_mode)) {
+    error = "not a regular file";
     return false;
   }
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    error = std::error_code(errno, std::generic_category()).message();
+  const auto size = static_cast<std::uint64_t>(info.st_size);
+  if (size > max_bytes) {
+    error = "file of " + std::to_string(size) + " bytes is larger than the " +
+            size_text(max_bytes) + " limit";
     return false;
   }
-  contents.clear();
-  char buffer[1 << 16];
-  std::size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof buffer, file)) > 0) contents.append(buffer, got);
-  const bool failed = std::ferror(file) != 0;
-  const int saved_errno = errno;
-  std::fclose(file);
-  if (failed) {
-    error = std::error_code(saved_errno, std::generic_category()).message();
-    return false;
+  contents.assign(static_cast<std::size_t>(size), '\0');
+  std::size_t done = 0;
+  while (done < contents.size()) {
+    const ssize_t got = ::read(fd, contents.data() + done, contents.size() - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return system_error(errno);
+    if (got == 0) break;  // the file shrank meanwhile: keep what is there
+    done += static_cast<std::size_t>(got);
   }
+  contents.resize(done);
   return true;
 }
 
@@ -93,6 +121,24 @@ std::size_t drop_nonfinite_triangles(MeshData& mesh) {
 }
 
 bool is_glb(std::string_view bytes) { return bytes.substr(0, 4) == "glTF"; }
+
+void check_obj_text(std::string_view text, const std::string& name) {
+  // OBJ is text: a NUL byte means binary data (a .glb, an image, a NUL-filled file), which
+  // the line parser would skip line by line and load as nothing.
+  if (is_glb(text))
+    throw InputError(name + ": " +
+                     "binary glTF (.glb), not an OBJ text file: name it with \"gltf\"");
+  if (text.find('\0') != std::string_view::npos) {
+    throw InputError(name + ": " + "binary data (a NUL byte at byte " +
+                     std::to_string(text.find('\0')) + "), not an OBJ text file");
+  }
+  // JSON (a .gltf file, a scene) starts with an object or array; no OBJ statement does.
+  std::string_view rest = text.substr(0, 3) == "\xEF\xBB\xBF" ? text.substr(3) : text;
+  const std::size_t first = rest.find_first_not_of(" \t\r\n");
+  if (first != std::string_view::npos && (rest[first] == '{' || rest[first] == '[')) {
+    throw InputError(name + ": " + "JSON, not an OBJ file (a .gltf file belongs under \"gltf\")");
+  }
+}
 
 }  // namespace detail
 

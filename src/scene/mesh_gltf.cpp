@@ -10,6 +10,7 @@
 // through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
+#include "scene/gltf_input.hpp"
 #include "scene/gltf_pose.hpp"
 #include "scene/gltf_textures.hpp"
 #include "scene/scene_internal.hpp"
@@ -195,16 +196,16 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
 /// The file as tinygltf reads it (images kept as bytes, keep_image_bytes; decoded later by
 /// covrast's decoder, never by stb_image); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
-                           const std::filesystem::path& base_dir) {
+                           const std::filesystem::path& base_dir, std::string& warn) {
+  check_gltf_input(bytes, name, base_dir);
   const std::optional<std::string> rewritten = without_draco_indices(bytes);
   if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
   loader.SetImageLoader(&keep_image_bytes, nullptr);
-  loader.SetFsCallbacks(regular_file_callbacks());
+  loader.SetFsCallbacks(gltf_fs_callbacks());
   tinygltf::Model model;
   std::string err;
-  std::string warn;
   const bool ok =
       is_glb(bytes)
           ? loader.LoadBinaryFromMemory(&model, &err, &warn,
@@ -387,6 +388,8 @@ class GltfMeshBuilder {
     const std::vector<glm::vec3> colors = vertex_colors(source, what, vertex_count, alphas);
     const TextureAttributes texture_attributes =
         read_texture_attributes(source, what, vertex_count);
+    check_copies(placement.skin_joints.empty() ? placement.worlds.size() : 1, vertex_count,
+                 corners.size() / 3, what);
     const std::uint32_t material = primitive.material >= 0
                                        ? static_cast<std::uint32_t>(primitive.material)
                                        : default_material_;
@@ -401,6 +404,21 @@ class GltfMeshBuilder {
                                placement.skin_joints, name_, what);
       place(skinned(vertices, skin), corners, colors, alphas, material, glm::dmat4(1.0),
             texture_attributes);
+    }
+  }
+
+  /// Before `copies` placed copies of a primitive are made: the file's vertices stay within
+  /// 32-bit indices and its triangles within kMaxSceneTriangles (instancing multiplies both).
+  void check_copies(std::size_t copies, std::size_t vertex_count, std::size_t triangle_count,
+                    const std::string& what) const {
+    const std::uint64_t vertices = std::uint64_t(copies) * vertex_count;
+    const std::uint64_t triangles = std::uint64_t(copies) * triangle_count;
+    if (vertices > kMaxVertices - mesh_->positions.size()) {
+      fail(name_, what + ": more than " + std::to_string(kMaxVertices) + " vertices in all");
+    }
+    if (triangles > kMaxSceneTriangles - mesh_->triangle_count()) {
+      fail(name_, what + ": " + std::to_string(copies) + " copies make more than " +
+                      std::to_string(kMaxSceneTriangles) + " triangles (docs/limits.md)");
     }
   }
 
@@ -874,12 +892,15 @@ class GltfMeshBuilder {
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
                       const std::filesystem::path& base_dir) {
-  const tinygltf::Model model = read_model(bytes, display_name, base_dir);
+  std::string warn;
+  const tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);
   const std::vector<int> roots = root_nodes(model, display_name);
   GltfMeshBuilder builder(model, display_name, base_dir);
   builder.add_node_trees(roots);
-  return builder.finish();
+  LoadedMesh loaded = builder.finish();
+  add_loader_warnings(warn, display_name, loaded.warnings);
+  return loaded;
 }
 
 }  // namespace covrast::detail

@@ -293,6 +293,11 @@ class ObjParser {
     corner_uvs_.clear();
     std::string_view token;
     while (tokens.next(token)) {
+      if (corners_.size() == kMaxObjFaceCorners) {
+        fail(name_, line_no,
+             "face has more than " + std::to_string(kMaxObjFaceCorners) +
+                 " corners (docs/limits.md)");
+      }
       corners_.push_back(corner_vertex(token, line_no));
       corner_normals_.push_back(corner_normal(token, normals_.size(), name_, line_no));
       corner_uvs_.push_back(corner_texcoord(token, texcoords_.size(), name_, line_no));
@@ -371,6 +376,7 @@ class ObjParser {
 }  // namespace
 
 LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
+  check_obj_text(text, display_name);
   ObjParser parser(display_name);
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   std::size_t pos = 0;

@@ -6,6 +6,7 @@
 #include <covrast/scene.hpp>
 
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -43,9 +44,19 @@ struct LoadedMesh {
   std::vector<FileCamera> cameras;
 };
 
-/// Reads a whole file. On failure returns false and sets `error` to the system's reason
-/// (e.g. "No such file or directory").
-bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error);
+/// Reads a whole regular file of at most `max_bytes`. On failure returns false and sets
+/// `error` to the reason (the system's, e.g. "No such file or directory", or "not a regular
+/// file", a size over the limit, a NUL byte in the path). Never blocks on a FIFO or device.
+bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
+                     std::uint64_t max_bytes = kMaxInputFileBytes);
+
+/// "1 GiB", "64 MiB" or "N bytes".
+std::string size_text(std::uint64_t bytes);
+
+/// The deepest nesting of arrays and objects in JSON text (strings and comments skipped),
+/// scanning no further than the first place where it exceeds `limit`; there `offset` is set
+/// to the byte of the opening bracket. Returns true when the depth stays within `limit`.
+bool json_depth_within(std::string_view text, int limit, std::size_t& offset);
 
 /// Wavefront OBJ: v (optionally with r g b sRGB colours) and f lines; polygons are split into
 /// the fan (0, k, k + 1). `display_name` prefixes every error message ("name:LINE: ...").
@@ -67,6 +78,10 @@ std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& pa
 /// Removes every triangle that uses a vertex with a non-finite coordinate and sets such
 /// vertices to the origin (nothing references them any more). Returns the number removed.
 std::size_t drop_nonfinite_triangles(MeshData& mesh);
+
+/// Throws InputError("name: ...") when `text` is not OBJ text: binary (a NUL byte, the glTF
+/// magic) or JSON.
+void check_obj_text(std::string_view text, const std::string& name);
 
 /// True if the bytes start with the binary glTF magic "glTF".
 bool is_glb(std::string_view bytes);

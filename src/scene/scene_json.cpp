@@ -3,6 +3,7 @@
 // linear light, and loads each mesh file once however many instances name it.
 #include "scene/scene_internal.hpp"
 
+#include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
@@ -47,10 +48,34 @@ std::pair<std::size_t, std::size_t> line_column(std::string_view text, std::size
   return {line, offset - line_start + 1};
 }
 
+/// nlohmann's message without its "[json.exception.KIND.NNN] " prefix.
+std::string exception_detail(const json::exception& e) {
+  std::string text = e.what();
+  if (text.rfind("[json.exception.", 0) == 0) {
+    if (const std::size_t end = text.find("] "); end != std::string::npos) text.erase(0, end + 2);
+  }
+  return text;
+}
+
 json parse_json(const std::string& text, const std::string& file) {
+  // Bounded before parsing: messages print values recursively (shown()).
+  if (std::size_t offset = 0; !detail::json_depth_within(text, kMaxJsonDepth, offset)) {
+    const auto [line, column] = line_column(text, offset);
+    throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(column) +
+                     ": arrays and objects nested deeper than " + std::to_string(kMaxJsonDepth) +
+                     " levels");
+  }
   try {
     // Comments (// and /* */) are accepted as an extension; they change no meaning.
     return json::parse(text, nullptr, true, true);
+  } catch (const json::out_of_range& e) {
+    // A number beyond double's range ("1e400"): out_of_range.406, without a position.
+    std::string detail = exception_detail(e);
+    for (char& c : detail) {
+      const auto byte = static_cast<unsigned char>(c);
+      if (byte < 0x20 || byte >= 0x7f) c = '?';
+    }
+    throw InputError(file + ": " + detail);
   } catch (const json::parse_error& e) {
     // e.byte counts the bytes read including the offending one, so it sits at e.byte - 1.
     const std::size_t offset = e.byte > 0 ? e.byte - 1 : 0;
@@ -159,6 +184,16 @@ class SceneReader {
     }
     const glm::dvec3 view = camera.target - camera.eye;
     if (view == glm::dvec3(0.0)) fail(file_, "camera", "eye and target must differ");
+    // |target - eye| and |up| must be finite, or the parallel test below (and the view
+    // matrix) overflow and blame the wrong key.
+    if (!std::isfinite(glm::length(view))) {
+      fail(file_, "camera.eye",
+           "too far from camera.target: |target - eye| overflows (eye " + shown(object["eye"]) +
+               ")");
+    }
+    if (!std::isfinite(glm::length(camera.up))) {
+      fail(file_, "camera.up", "too large: its length overflows, got " + shown(object["up"]));
+    }
     // Parallel when sin(angle(view, up)) = |view x up| / (|view| |up|) is (nearly) zero.
     const double up_length = glm::length(camera.up);
     if (!(up_length > 0.0) ||
@@ -286,6 +321,11 @@ class SceneReader {
 
   std::vector<Light> lights(const json& value) const {
     if (!value.is_array()) fail(file_, "lights", "expected an array, got " + shown(value));
+    if (value.size() > kMaxSceneLights) {
+      fail(file_, "lights",
+           std::to_string(value.size()) + " lights, more than " + std::to_string(kMaxSceneLights) +
+               " (docs/limits.md)");
+    }
     std::vector<Light> result;
     for (std::size_t i = 0; i < value.size(); ++i) {
       result.push_back(light(value[i], "lights[" + std::to_string(i) + "]"));
@@ -443,6 +483,10 @@ MeshFileRef mesh_file_ref(const std::string& file, const json& entry, const std:
   if (!path_value.is_string() || path_value.get<std::string>().empty()) {
     fail(file, path_key, "expected a file path string, got " + shown(path_value));
   }
+  // "\u0000" would otherwise quietly name the path before it.
+  if (path_value.get<std::string>().find('\0') != std::string::npos) {
+    fail(file, path_key, "the path contains a NUL byte (\\u0000)");
+  }
   return {format, path_value.get<std::string>()};
 }
 
@@ -496,6 +540,11 @@ class SceneMeshes {
                                " triangles with NaN/Inf coordinates");
     }
     for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
+    // Nothing loads as empty without a word (a file of the wrong kind, wrong JSON types).
+    if (loaded.data->triangle_count() == 0) {
+      scene.warnings.push_back(full.lexically_normal().string() +
+                               ": no triangles: the mesh draws nothing");
+    }
     if (scene.lit) {
       for (const std::string& warning : loaded.lit_warnings) scene.warnings.push_back(warning);
     }
@@ -653,11 +702,40 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
   return camera;
 }
 
+/// A warning for every instance whose model matrix takes it out of the finite range: its
+/// clip-space coordinates, clip = P V M p (docs/architecture.md) computed in double as the
+/// front end does, overflow at a corner of its box, so that the clipper can only cull it.
+void warn_beyond_finite_range(Scene& scene) {
+  const Camera& cam = scene.camera;
+  const glm::dmat4 view_projection =
+      glm::perspective(glm::radians(cam.fovy_deg), double(scene.width) / double(scene.height),
+                       cam.near, cam.far) *
+      glm::lookAt(cam.eye, cam.target, cam.up);
+  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
+    const MeshInstance& instance = scene.meshes[i];
+    if (instance.mesh->triangle_count() == 0) continue;
+    const glm::dmat4 mvp = view_projection * instance.model;
+    const glm::dvec3 lo(instance.mesh->bounds_min), hi(instance.mesh->bounds_max);
+    bool finite = true;
+    for (int corner = 0; corner < 8 && finite; ++corner) {
+      const glm::dvec4 clip = mvp * glm::dvec4(corner & 1 ? hi.x : lo.x, corner & 2 ? hi.y : lo.y,
+                                               corner & 4 ? hi.z : lo.z, 1.0);
+      finite = std::isfinite(clip.x) && std::isfinite(clip.y) && std::isfinite(clip.z) &&
+               std::isfinite(clip.w);
+    }
+    if (!finite) {
+      scene.warnings.push_back(scene.source.string() + ": meshes[" + std::to_string(i) +
+                               "]: the mesh lies outside the finite range (its model matrix "
+                               "makes clip-space coordinates overflow): nothing of it is drawn");
+    }
+  }
+}
+
 /// The scene file's top-level JSON object.
 json read_scene_root(const std::filesystem::path& json_path, const std::string& file) {
   std::string text;
   std::string error;
-  if (!detail::read_whole_file(json_path, text, error)) {
+  if (!detail::read_whole_file(json_path, text, error, kMaxSceneFileBytes)) {
     throw InputError(file + ": cannot open: " + error);
   }
   json root = parse_json(text, file);
@@ -675,12 +753,30 @@ std::size_t Scene::triangle_count() const {
   return total;
 }
 
+namespace {
+Scene load_scene_files(const std::filesystem::path& json_path,
+                       std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files);
+}  // namespace
+
 Scene load_scene(const std::filesystem::path& json_path) {
   MeshFileCache meshes;
   return load_scene(json_path, meshes);
 }
 
 Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
+  // Every JSON access checks its type first; this is the net under them, so that a missed
+  // check is still an input error naming the file, not an internal error.
+  try {
+    return load_scene_files(json_path, mesh_files.impl_->files);
+  } catch (const json::exception& e) {
+    throw InputError(json_path.string() + ": " + exception_detail(e));
+  }
+}
+
+namespace {
+
+Scene load_scene_files(const std::filesystem::path& json_path,
+                       std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files) {
   const std::string file = json_path.string();
   const json root = read_scene_root(json_path, file);
   const SceneReader reader(file);
@@ -702,14 +798,24 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  SceneMeshes cache(file, json_path.parent_path(), mesh_files.impl_->files);
+  SceneMeshes cache(file, json_path.parent_path(), files);
   FirstGltf first_gltf;
+  std::uint64_t triangles = 0;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string key = "meshes[" + std::to_string(i) + "]";
     scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene, first_gltf));
+    triangles += scene.meshes.back().mesh->triangle_count();
+    if (triangles > kMaxSceneTriangles) {
+      fail(file, key,
+           "the scene's instances draw " + std::to_string(triangles) + " triangles, more than " +
+               std::to_string(kMaxSceneTriangles) + " (docs/limits.md)");
+    }
   }
   if (camera_from_gltf) scene.camera = gltf_camera(file, camera, first_gltf, scene);
+  warn_beyond_finite_range(scene);
   return scene;
 }
+
+}  // namespace
 
 }  // namespace covrast

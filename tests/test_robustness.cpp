@@ -1,0 +1,236 @@
+// Tests: the loaders' defences against hostile input (issue 15, docs/limits.md) at the level
+// of the library: the JSON depth pre-scan, the whole-file reader (regular files only, size
+// limit, NUL bytes, no blocking on FIFOs), the OBJ face limit and its cost, the scene's
+// triangle limit, and the warnings for what loads but draws nothing. The CLI view of the same
+// inputs is the bad-input corpus (test_bad_input_corpus.cpp).
+#include <covrast/error.hpp>
+#include <covrast/scene.hpp>
+
+#include <sys/stat.h>
+
+#include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "scene/scene_internal.hpp"
+#include "test_cli_run.hpp"
+#include "test_gltf_files.hpp"
+#include "test_tempdir.hpp"
+
+namespace fs = std::filesystem;
+using covrast::InputError;
+using covrast::test::GltfBuilder;
+using covrast::test::TempDir;
+using covrast::test::write_text;
+
+namespace {
+
+const std::string kCamera =
+    R"("camera":{"eye":[0,0,3],"target":[0,0,0],"up":[0,1,0],"fovy_deg":45,"near":0.1,"far":100})";
+
+std::string scene_text(const std::string& meshes) {
+  return R"({"width":8,"height":8,)" + kCamera + R"(,"meshes":)" + meshes + "}";
+}
+
+std::string load_error(const std::function<void()>& load) {
+  try {
+    load();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no InputError)";
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+}  // namespace
+
+TEST_CASE("robust: the JSON depth pre-scan counts brackets outside strings and comments",
+          "[robust]") {
+  std::size_t offset = 0;
+  CHECK(covrast::detail::json_depth_within("[[1]]", 2, offset));
+  CHECK_FALSE(covrast::detail::json_depth_within("[[[1]]]", 2, offset));
+  CHECK(offset == 2);  // the third '['
+  CHECK_FALSE(covrast::detail::json_depth_within(R"({"a":{"b":[1]}})", 2, offset));
+  CHECK(offset == 10);
+  // Brackets inside strings (also after an escaped quote) and comments do not count.
+  CHECK(covrast::detail::json_depth_within(R"(["[[[[", "\"[[[[", 1])", 1, offset));
+  CHECK(covrast::detail::json_depth_within("[1, // [[[[\n 2 /* {{{{ */]", 1, offset));
+  // Sequential arrays do not add up.
+  CHECK(covrast::detail::json_depth_within("[[1],[2],[3]]", 2, offset));
+  CHECK(covrast::detail::json_depth_within("[[1],[2],{\"a\":[4]}]", 3, offset));
+  CHECK_FALSE(covrast::detail::json_depth_within("[[1],[2],{\"a\":[4]}]", 2, offset));
+  // 100,000 levels: measured without recursion.
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  CHECK(covrast::detail::json_depth_within(deep, 100000, offset));
+  CHECK_FALSE(covrast::detail::json_depth_within(deep, 99999, offset));
+  CHECK(offset == 99999);
+}
+
+TEST_CASE("robust: read_whole_file reads regular files only, up to its limit", "[robust]") {
+  TempDir dir("covrast-robust");
+  std::string bytes;
+  std::string error;
+  write_text(dir / "ten.txt", "0123456789");
+  CHECK(covrast::detail::read_whole_file(dir / "ten.txt", bytes, error, 10));
+  CHECK(bytes == "0123456789");
+  CHECK_FALSE(covrast::detail::read_whole_file(dir / "ten.txt", bytes, error, 9));
+  CHECK(error == "file of 10 bytes is larger than the 9 bytes limit");
+  CHECK_FALSE(covrast::detail::read_whole_file("/dev/zero", bytes, error));
+  CHECK(error == "not a regular file");
+  CHECK_FALSE(covrast::detail::read_whole_file(dir.path(), bytes, error));
+  CHECK(error == "Is a directory");
+  // A FIFO without a writer: refused at once, not waited on.
+  REQUIRE(::mkfifo((dir / "pipe").c_str(), 0600) == 0);
+  const auto start = std::chrono::steady_clock::now();
+  CHECK_FALSE(covrast::detail::read_whole_file(dir / "pipe", bytes, error));
+  CHECK(error == "not a regular file");
+  CHECK(seconds_since(start) < 5.0);
+  // An embedded NUL would otherwise open "ten.txt".
+  const std::string with_nul = (dir / "ten.txt").string() + std::string("\0.x", 3);
+  CHECK_FALSE(covrast::detail::read_whole_file(fs::path(with_nul), bytes, error));
+  CHECK(error == "the path contains a NUL byte");
+  CHECK(covrast::detail::size_text(std::uint64_t(1) << 30) == "1 GiB");
+  CHECK(covrast::detail::size_text(std::uint64_t(1) << 26) == "64 MiB");
+}
+
+TEST_CASE("robust: an OBJ face of many corners is linear, past the limit an error", "[robust]") {
+  TempDir dir("covrast-robust");
+  // A polygon at the limit: kMaxObjFaceCorners corners on a circle (a convex fan).
+  std::string obj;
+  const std::uint64_t corners = covrast::kMaxObjFaceCorners;
+  for (std::uint64_t i = 0; i < corners; ++i) {
+    const double angle = 6.283185307179586 * double(i) / double(corners);
+    obj += "v ";
+    obj += std::to_string(std::cos(angle));
+    obj += ' ';
+    obj += std::to_string(std::sin(angle));
+    obj += " 0\n";
+  }
+  std::string face = "f";
+  for (std::uint64_t i = 1; i <= corners; ++i) {
+    face += ' ';  // appended piecewise: " " + std::string trips a g++ 12 -Wrestrict warning
+    face += std::to_string(i);
+  }
+  write_text(dir / "big.obj", obj + face + "\n");
+  auto start = std::chrono::steady_clock::now();
+  const auto mesh = covrast::load_mesh(dir / "big.obj");
+  CHECK(mesh->triangle_count() == corners - 2);
+  CHECK(seconds_since(start) < 10.0);
+  // One face line of 20 MB (the finding: minutes before): refused at the corner limit.
+  std::string huge = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  while (huge.size() < 20'000'000) huge += " 1 2 3";
+  write_text(dir / "huge.obj", huge + "\n");
+  start = std::chrono::steady_clock::now();
+  CHECK(load_error([&] { covrast::load_mesh(dir / "huge.obj"); }) ==
+        (dir / "huge.obj").string() + ":4: face has more than 65536 corners (docs/limits.md)");
+  CHECK(seconds_since(start) < 10.0);
+}
+
+TEST_CASE("robust: a scene that draws more than kMaxSceneTriangles is refused", "[robust]") {
+  TempDir dir("covrast-robust");
+  // A glTF mesh of 2^20 triangles (an accessor without a bufferView: zeros, no file bytes),
+  // named by the scene 33 times: 33 * 2^20 > 2^25.
+  GltfBuilder builder;
+  builder.gltf["accessors"] = {{{"componentType", 5126}, {"count", 3 << 20}, {"type", "VEC3"}}};
+  builder.single_mesh({{{"attributes", {{"POSITION", 0}}}}});
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  std::string meshes = "[";
+  for (int i = 0; i < 33; ++i) meshes += std::string(i ? "," : "") + R"({"gltf":"m.gltf"})";
+  write_text(dir / "s.json", scene_text(meshes + "]"));
+  CHECK(load_error([&] { covrast::load_scene(dir / "s.json"); }) ==
+        (dir / "s.json").string() +
+            ": meshes[32]: the scene's instances draw 34603008 triangles, more than 33554432 "
+            "(docs/limits.md)");
+  // 32 instances are within the limit.
+  write_text(dir / "s.json", scene_text(meshes.substr(0, meshes.size() - 18) + "]"));
+  CHECK(covrast::load_scene(dir / "s.json").triangle_count() == 32u << 20);
+}
+
+TEST_CASE("robust: a glTF file whose instances make more than kMaxSceneTriangles is refused",
+          "[robust]") {
+  TempDir dir("covrast-robust");
+  // 2^20 triangles (zeros, no file bytes), instanced 33 times by EXT_mesh_gpu_instancing:
+  // refused before the first copy is made.
+  GltfBuilder builder;
+  builder.gltf["accessors"] = {{{"componentType", 5126}, {"count", 3 << 20}, {"type", "VEC3"}},
+                               {{"componentType", 5126}, {"count", 33}, {"type", "VEC3"}}};
+  builder.single_mesh({{{"attributes", {{"POSITION", 0}}}}});
+  builder.gltf["nodes"][0]["extensions"] = {
+      {"EXT_mesh_gpu_instancing", {{"attributes", {{"TRANSLATION", 1}}}}}};
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  const auto start = std::chrono::steady_clock::now();
+  CHECK(load_error([&] { covrast::load_mesh(dir / "m.gltf"); }) ==
+        (dir / "m.gltf").string() +
+            ": mesh 0 primitive 0: 33 copies make more than 33554432 triangles (docs/limits.md)");
+  CHECK(seconds_since(start) < 10.0);
+  // 2 copies load (2 * 2^20 triangles).
+  builder.gltf["accessors"][1]["count"] = 2;
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  CHECK(covrast::load_mesh(dir / "m.gltf")->triangle_count() == 2u << 20);
+}
+
+TEST_CASE("robust: a glTF accessor over the element limit is refused before allocating",
+          "[robust]") {
+  TempDir dir("covrast-robust");
+  GltfBuilder builder;
+  builder.gltf["accessors"] = {
+      {{"componentType", 5126}, {"count", covrast::kMaxAccessorElements + 1}, {"type", "VEC3"}}};
+  builder.single_mesh({{{"attributes", {{"POSITION", 0}}}}});
+  write_text(dir / "m.gltf", builder.gltf.dump());
+  const auto start = std::chrono::steady_clock::now();
+  CHECK(load_error([&] { covrast::load_mesh(dir / "m.gltf"); }) ==
+        (dir / "m.gltf").string() +
+            ": mesh 0 primitive 0 POSITION: accessor 0 has 16777217 elements, more than the "
+            "16777216 covrast reads (docs/limits.md)");
+  CHECK(seconds_since(start) < 5.0);
+}
+
+TEST_CASE("robust: what loads but draws nothing is a warning", "[robust]") {
+  TempDir dir("covrast-robust");
+  write_text(dir / "tri.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n");
+  write_text(dir / "empty.obj", "# no faces\n");
+  SECTION("a mesh file without triangles") {
+    write_text(dir / "s.json", scene_text(R"([{"obj":"empty.obj"},{"obj":"tri.obj"}])"));
+    const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+    REQUIRE(scene.warnings.size() == 1);
+    CHECK(scene.warnings[0] ==
+          (dir / "empty.obj").string() + ": no triangles: the mesh draws nothing");
+  }
+  SECTION("a model matrix beyond the finite range") {
+    write_text(
+        dir / "s.json",
+        scene_text(
+            R"([{"obj":"tri.obj"},{"obj":"tri.obj","model":[1e308,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1]}])"));
+    const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+    REQUIRE(scene.warnings.size() == 1);
+    CHECK(scene.warnings[0] ==
+          (dir / "s.json").string() +
+              ": meshes[1]: the mesh lies outside the finite range (its model matrix makes "
+              "clip-space coordinates overflow): nothing of it is drawn");
+  }
+  SECTION("large but finite model matrices give no warning") {
+    write_text(
+        dir / "s.json",
+        scene_text(R"([{"obj":"tri.obj","model":[1e30,0,0,0,0,1e30,0,0,0,0,1,0,0,0,0,1]}])"));
+    CHECK(covrast::load_scene(dir / "s.json").warnings.empty());
+  }
+  SECTION("tinygltf's warnings: an image file it cannot load") {
+    GltfBuilder builder;
+    const int positions = builder.add_floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    builder.single_mesh({{{"attributes", {{"POSITION", positions}}}}});
+    builder.gltf["images"] = {{{"uri", "missing.png"}}};
+    write_text(dir / "m.gltf", builder.gltf_text());
+    write_text(dir / "s.json", scene_text(R"([{"gltf":"m.gltf"}])"));
+    const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+    REQUIRE_FALSE(scene.warnings.empty());
+    CHECK(scene.warnings[0].rfind((dir / "m.gltf").string() + ": File not found : missing.png",
+                                  0) == 0);
+  }
+}
