@@ -53,6 +53,11 @@ struct Material {
   /// material lights them with the normal as it is (glTF would cull them; covrast draws
   /// them, see docs/shading.md).
   bool double_sided = true;
+  /// Opacity, 0..1 (OBJ's MTL `d`); stored for the alpha modes, not used by shading yet.
+  double base_alpha = 1.0;
+  /// The base colour texture's file (OBJ's MTL `map_Kd`, resolved against the .mtl file's
+  /// directory); empty if none. Kept for the texture loader, not used yet.
+  std::string base_color_texture_path;
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };

@@ -47,9 +47,12 @@ struct LoadedMesh {
 /// (e.g. "No such file or directory").
 bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error);
 
-/// Wavefront OBJ: v (optionally with r g b sRGB colours) and f lines; polygons are split into
-/// the fan (0, k, k + 1). `display_name` prefixes every error message ("name:LINE: ...").
-LoadedMesh parse_obj(std::string_view text, const std::string& display_name);
+/// Wavefront OBJ: v (optionally with r g b sRGB colours), vn, f, mtllib and usemtl lines;
+/// convex polygons become the fan (0, k, k + 1), concave ones are ear-clipped. `display_name`
+/// prefixes every error message ("name:LINE: ..."); material libraries are found in
+/// `base_dir`.
+LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
+                     const std::filesystem::path& base_dir);
 
 /// glTF 2.0, either JSON (.gltf) or binary (.glb, recognised by its magic). External buffers
 /// are resolved against `base_dir`.

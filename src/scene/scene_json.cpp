@@ -493,7 +493,7 @@ class SceneMeshes {
       fail(file_, key, "cannot open '" + ref.relative + "': " + error);
     }
     const std::string display = full.lexically_normal().string();
-    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display)
+    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display, full.parent_path())
                                          : detail::parse_gltf(bytes, display, full.parent_path());
   }
 
