@@ -10,6 +10,7 @@
 // through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
+#include "scene/gltf_lights.hpp"
 #include "scene/gltf_pose.hpp"
 #include "scene/scene_internal.hpp"
 
@@ -216,9 +217,9 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 5> kImplementedExtensions = {
-    kDracoExtension, "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
-    "KHR_materials_unlit", "KHR_mesh_quantization"};
+constexpr std::array<std::string_view, 6> kImplementedExtensions = {
+    kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
+    "KHR_materials_unlit", "KHR_mesh_quantization",   kLightsExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -296,12 +297,15 @@ class GltfMeshBuilder {
       const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
       if (node.mesh >= 0) add_mesh(node_index, node.mesh, node_placement(node_index));
       if (node.camera >= 0) place_camera(node_index, node.camera);
+      const glm::dmat4& world = node_world_[static_cast<std::size_t>(node_index)];
+      if (auto light = node_light(model_, node_index, world, name_)) lights_.push_back(*light);
     }
   }
 
   LoadedMesh finish() {
     LoadedMesh loaded;
     loaded.cameras = std::move(cameras_);
+    loaded.lights = std::move(lights_);
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
@@ -750,6 +754,7 @@ class GltfMeshBuilder {
   std::size_t emissive_textures_ = 0;   ///< materials whose emission is left out
   bool any_normals_ = false;
   std::vector<FileCamera> cameras_;
+  std::vector<FileLight> lights_;       ///< KHR_lights_punctual, in walk order
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
   std::vector<bool> reached_;           ///< per node: in the walked scene
   /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per

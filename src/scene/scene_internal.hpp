@@ -26,6 +26,16 @@ struct FileCamera {
   glm::dmat4 world{1.0};
 };
 
+/// A glTF KHR_lights_punctual light on a node of the walked scene (gltf_lights.cpp): type,
+/// colour, intensity, range and cone angles [degrees] as the file gives them; it sits at the
+/// origin of `world` (the node's world transform) and shines down its -z.
+struct FileLight {
+  Light light;
+  glm::dmat4 world{1.0};
+  int index = 0;  ///< in the file's lights
+  int node = 0;   ///< the node that places it
+};
+
 /// A parsed mesh file plus what MeshData cannot carry.
 struct LoadedMesh {
   std::shared_ptr<MeshData> data;
@@ -41,6 +51,8 @@ struct LoadedMesh {
   std::vector<std::string> lit_warnings;
   /// glTF: the file's cameras, in file order.
   std::vector<FileCamera> cameras;
+  /// glTF: the lights on the walked nodes, in walk order.
+  std::vector<FileLight> lights;
 };
 
 /// Reads a whole file. On failure returns false and sets `error` to the system's reason

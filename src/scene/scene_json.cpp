@@ -11,6 +11,7 @@
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -284,11 +285,25 @@ class SceneReader {
     }
   }
 
-  std::vector<Light> lights(const json& value) const {
-    if (!value.is_array()) fail(file_, "lights", "expected an array, got " + shown(value));
+  /// "lights": an array of light objects in which the string "gltf" (once) stands for the
+  /// lights of the scene's glTF files, or just "gltf"; `gltf_at` is where those go.
+  std::vector<Light> lights(const json& value, std::optional<std::size_t>& gltf_at) const {
+    if (value == "gltf") {
+      gltf_at = 0;
+      return {};
+    }
+    if (!value.is_array()) {
+      fail(file_, "lights", "expected an array or \"gltf\", got " + shown(value));
+    }
     std::vector<Light> result;
     for (std::size_t i = 0; i < value.size(); ++i) {
-      result.push_back(light(value[i], "lights[" + std::to_string(i) + "]"));
+      const std::string key = "lights[" + std::to_string(i) + "]";
+      if (value[i] == "gltf") {
+        if (gltf_at) fail(file_, key, "\"gltf\" given twice");
+        gltf_at = result.size();
+      } else {
+        result.push_back(light(value[i], key));
+      }
     }
     return result;
   }
@@ -550,6 +565,8 @@ struct FirstGltf {
   const detail::LoadedMesh* loaded = nullptr;  ///< null: no glTF mesh (yet)
   std::string relative;                        ///< the file as the scene names it
   glm::dmat4 model{1.0};                       ///< the entry's model matrix
+  /// Every glTF entry (file and model matrix), where "lights": "gltf" takes lights from.
+  std::vector<std::pair<const detail::LoadedMesh*, glm::dmat4>> all;
 };
 
 /// Entry `key` of "meshes": its mesh (loaded through `cache`), colour, model matrix,
@@ -573,8 +590,9 @@ MeshInstance load_instance(const SceneReader& reader, const std::string& file, c
   instance.materials = instance_materials(reader, entry, key, *loaded.data);
   select_normals(reader, file, entry, key, ref.relative, cached, instance);
   if (ref.format == MeshFormat::Gltf && first_gltf.loaded == nullptr) {
-    first_gltf = {&loaded, ref.relative, instance.model};
+    first_gltf = {&loaded, ref.relative, instance.model, {}};
   }
+  if (ref.format == MeshFormat::Gltf) first_gltf.all.emplace_back(&loaded, instance.model);
   return instance;
 }
 
@@ -637,6 +655,30 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
   return camera;
 }
 
+/// "lights": "gltf": the KHR_lights_punctual lights of every glTF mesh entry, in entry order
+/// and each file's walk order, placed at the light's node's world transform times the
+/// entry's model matrix; the light shines down the node's -z. Checked as add_light checks.
+std::vector<Light> gltf_lights(const std::string& file, const FirstGltf& gltf) {
+  std::vector<Light> lights;
+  for (const auto& [loaded, model] : gltf.all) {
+    for (const detail::FileLight& source : loaded->lights) {
+      const glm::dmat4 world = model * source.world;
+      Light light = source.light;
+      light.position = glm::dvec3(world[3]);
+      light.direction = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+      const double length = glm::length(light.direction);
+      if (light.type != LightType::Point && (!(length > 0.0) || !std::isfinite(length))) {
+        fail(file, "lights",
+             "light " + std::to_string(source.index) + " of '" + loaded->data->source + "' (node " +
+                 std::to_string(source.node) + "): its transform is degenerate");
+      }
+      if (length > 0.0) light.direction /= length;
+      lights.push_back(light);
+    }
+  }
+  return lights;
+}
+
 /// The scene file's top-level JSON object.
 json read_scene_root(const std::filesystem::path& json_path, const std::string& file) {
   std::string text;
@@ -679,9 +721,10 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
   const json& camera = reader.required(root, "camera", "camera");
   const bool camera_from_gltf = camera.is_object() && camera.contains("gltf");
   if (!camera_from_gltf) scene.camera = reader.camera(root);
+  std::optional<std::size_t> gltf_lights_at;
   if (const auto it = root.find("lights"); it != root.end()) {
     scene.lit = true;
-    scene.lights = reader.lights(*it);
+    scene.lights = reader.lights(*it, gltf_lights_at);
   }
 
   const json& meshes = reader.required(root, "meshes", "meshes");
@@ -693,6 +736,11 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
     scene.meshes.push_back(load_instance(reader, file, meshes[i], key, cache, scene, first_gltf));
   }
   if (camera_from_gltf) scene.camera = gltf_camera(file, camera, first_gltf, scene);
+  if (gltf_lights_at) {
+    const std::vector<Light> lights = gltf_lights(file, first_gltf);
+    scene.lights.insert(scene.lights.begin() + std::ptrdiff_t(*gltf_lights_at), lights.begin(),
+                        lights.end());
+  }
   return scene;
 }
 
