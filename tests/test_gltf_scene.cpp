@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -190,4 +191,126 @@ TEST_CASE("bad KHR_lights_punctual content is an InputError naming node and ligh
              Contains("scene.json: lights[1]: \"gltf\" given twice"));
   CHECK_THAT(dir.load_error(scene_json({{{"gltf", "ok.glb"}}}, "sun")),
              Contains("scene.json: lights: expected an array or \"gltf\", got \"sun\""));
+}
+
+namespace {
+
+/// An orthographic camera at (0, 0, 5) looking at the origin with ymag 2:
+/// the 40 x 20 image spans x in [-4, 4] and y in [-2, 2], 0.2 world units per pixel.
+json ortho_camera() {
+  return {
+      {"eye", {0, 0, 5}}, {"target", {0, 0, 0}}, {"up", {0, 1, 0}}, {"projection", "orthographic"},
+      {"ymag", 2},        {"near", 1},           {"far", 10}};
+}
+
+/// A quad over x in [-1, 1.4], y in [-0.6, 1], tilted in depth (z from -1 to 1 along x), so
+/// that only a parallel projection gives it straight pixel-aligned edges.
+const char* kTiltedQuad = "v -1 -0.6 -1\nv 1.4 -0.6 1\nv 1.4 1 1\nv -1 1 -1\nf 1 2 3 4\n";
+
+}  // namespace
+
+TEST_CASE("an orthographic camera covers exactly the predicted pixels", "[camera][ortho]") {
+  TempDir dir;
+  dir.write("quad.obj", kTiltedQuad);
+  const json scene_json = {{"width", 40},
+                           {"height", 20},
+                           {"camera", ortho_camera()},
+                           {"meshes", {{{"obj", "quad.obj"}, {"color", {1, 1, 1}}}}}};
+  const covrast::Scene scene = dir.load(scene_json);
+  REQUIRE(scene.camera.orthographic);
+  REQUIRE(scene.camera.ymag == 2.0);
+  // x = -1 .. 1.4 is columns (x + 4) / 0.2 = 15 .. 27, y = 1 .. -0.6 rows (2 - y) / 0.2 = 5 .. 13.
+  for (const char* mode : {"coverage", "aliased", "ssaa:4", "reference"}) {
+    const covrast::Image image = render(scene, mode);
+    int wrong = 0;
+    for (int y = 0; y < 20; ++y) {
+      for (int x = 0; x < 40; ++x) {
+        const bool inside = x >= 15 && x < 27 && y >= 5 && y < 13;
+        wrong += image.pixel(x, y)[1] != (inside ? 255 : 0);
+      }
+    }
+    INFO(mode);
+    CHECK(wrong == 0);
+  }
+}
+
+TEST_CASE("orthographic shading sees every point from the same direction", "[camera][ortho]") {
+  TempDir dir;
+  dir.write("quad.obj", "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n");
+  json scene_json = {{"width", 40},
+                     {"height", 20},
+                     {"camera", ortho_camera()},
+                     {"meshes",
+                      {{{"obj", "quad.obj"},
+                        {"color", {0.5, 0.5, 0.5}},
+                        {"material", {{"model", "blinn-phong"}, {"shininess", 4}}}}}},
+                     {"lights", {{{"type", "directional"}, {"direction", {-0.3, -0.2, -1}}}}}};
+  // A plane, a directional light and parallel view rays: n, l and v are the same everywhere,
+  // so every covered pixel has one colour (a perspective view varies the highlight).
+  const auto colours = [&](const json& s) {
+    const covrast::Image image = render(dir.load(s), "aliased");
+    std::vector<int> seen;
+    for (int y = 0; y < 20; ++y) {
+      for (int x = 0; x < 40; ++x) {
+        const int c = image.pixel(x, y)[0] << 16 | image.pixel(x, y)[1] << 8 | image.pixel(x, y)[2];
+        if (c != 0 && std::find(seen.begin(), seen.end(), c) == seen.end()) seen.push_back(c);
+      }
+    }
+    return seen;
+  };
+  CHECK(colours(scene_json).size() == 1);
+  scene_json["camera"] = {{"eye", {0, 0, 2}}, {"target", {0, 0, 0}}, {"up", {0, 1, 0}},
+                          {"fovy_deg", 90},   {"near", 0.5},         {"far", 10}};
+  CHECK(colours(scene_json).size() > 10);
+}
+
+TEST_CASE("a glTF orthographic camera renders as the same scene camera", "[camera][ortho]") {
+  TempDir dir;
+  dir.write("quad.obj", kTiltedQuad);
+  GltfBuilder b = square_file();
+  b.gltf["cameras"] = {{{"type", "orthographic"},
+                        {"orthographic", {{"xmag", 9}, {"ymag", 2}, {"znear", 1}, {"zfar", 10}}}}};
+  b.gltf["scenes"] = {{{"nodes", {0, 1}}}};
+  b.gltf["nodes"] = {{{"mesh", 0}, {"scale", {0.01, 0.01, 0.01}}},
+                     {{"translation", {0, 0, 5}}, {"camera", 0}}};
+  dir.write("camera.glb", b.glb());
+  const json meshes = {{{"obj", "quad.obj"}, {"color", {1, 1, 1}}}, {{"gltf", "camera.glb"}}};
+  const covrast::Scene from_file =
+      dir.load({{"width", 40}, {"height", 20}, {"camera", {{"gltf", 0}}}, {"meshes", meshes}});
+  CHECK(from_file.camera.orthographic);
+  CHECK(from_file.camera.ymag == 2.0);
+  CHECK(from_file.camera.eye == glm::dvec3(0, 0, 5));
+  CHECK(from_file.camera.near == 1.0);
+  CHECK(from_file.camera.far == 10.0);
+  const covrast::Scene written =
+      dir.load({{"width", 40}, {"height", 20}, {"camera", ortho_camera()}, {"meshes", meshes}});
+  CHECK(render(from_file).rgb == render(written).rgb);
+
+  b.gltf["cameras"][0]["orthographic"]["ymag"] = 0;
+  dir.write("camera.glb", b.glb());
+  CHECK_THAT(dir.load_error(
+                 {{"width", 40}, {"height", 20}, {"camera", {{"gltf", 0}}}, {"meshes", meshes}}),
+             Contains("camera.gltf: camera 0 of 'camera.glb' (orthographic) needs ymag > 0"));
+}
+
+TEST_CASE("bad orthographic camera keys are InputErrors", "[camera][ortho]") {
+  TempDir dir;
+  const auto error_of = [&](const json& patch) {
+    json camera = ortho_camera();
+    camera.merge_patch(patch);
+    return dir.load_error(
+        {{"width", 8}, {"height", 8}, {"camera", camera}, {"meshes", json::array()}});
+  };
+  CHECK_THAT(error_of({{"projection", "fisheye"}}),
+             Contains("camera.projection: expected \"perspective\" or \"orthographic\""));
+  CHECK_THAT(error_of({{"fovy_deg", 40}}),
+             Contains("camera.fovy_deg: an orthographic camera takes ymag"));
+  CHECK_THAT(error_of({{"ymag", nullptr}}), Contains("camera.ymag: missing"));
+  CHECK_THAT(error_of({{"ymag", 0}}), Contains("camera.ymag: must be > 0, got 0"));
+  CHECK_THAT(error_of({{"near", -1}}), Contains("camera.near: must be >= 0, got -1"));
+  CHECK_THAT(error_of({{"projection", "perspective"}, {"fovy_deg", 40}}),
+             Contains("camera.ymag: only for an orthographic camera"));
+  CHECK(
+      dir.load({{"width", 8}, {"height", 8}, {"camera", ortho_camera()}, {"meshes", json::array()}})
+          .camera.orthographic);
 }

@@ -22,14 +22,17 @@ namespace covrast {
 inline constexpr int kMaxImageSide = 16384;
 
 /// OpenGL conventions: view = lookAt(eye, target, up), projection =
-/// perspective(fovy, width / height of the output image, near, far), clip z in [-w, w].
+/// perspective(fovy, width / height of the output image, near, far), or for an orthographic
+/// camera ortho(-ymag x aspect, ymag x aspect, -ymag, ymag, near, far); clip z in [-w, w].
 struct Camera {
   glm::dvec3 eye{0.0, 0.0, 3.0};
   glm::dvec3 target{0.0, 0.0, 0.0};
   glm::dvec3 up{0.0, 1.0, 0.0};
-  double fovy_deg = 45.0;  ///< vertical field of view [degrees], in (0, 180)
-  double near = 0.1;       ///< near plane distance [world units], > 0
-  double far = 100.0;      ///< far plane distance [world units], > near
+  double fovy_deg = 45.0;     ///< vertical field of view [degrees], in (0, 180); perspective
+  double near = 0.1;          ///< near plane distance [world units], > 0 (orthographic: >= 0)
+  double far = 100.0;         ///< far plane distance [world units], > near
+  bool orthographic = false;  ///< parallel projection: ymag instead of fovy_deg
+  double ymag = 1.0;          ///< orthographic: half the view's height [world units], > 0
 };
 
 /// How a lit surface reflects light (docs/shading.md has every formula and its source).

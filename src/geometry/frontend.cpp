@@ -131,9 +131,10 @@ inline SnappedVertex snapped_vertex(double x_fx8, double y_fx8, double z_window,
 // s_world > 0, so the dropped facing is clockwise (front_facing false) for s_world > 0 and
 // counter-clockwise for s_world < 0.
 // With a perspective camera, (c) alone already puts the eye outside the mesh's convex hull
-// (every vertex is at least `near` in front of it); (b) is a cheap second guard. covrast's
-// camera is perspective only; an orthographic one would have the eye at infinity and parallel
-// rays that start on the near plane, so (c) alone would suffice there and (b) would drop out.
+// (every vertex is at least `near` in front of it); (b) is a cheap second guard. With an
+// orthographic camera the rays are parallel and start on the near plane, and (c) puts every
+// vertex beyond it, so every ray starts outside the surface by (c) alone; (b), still tested,
+// can then only keep back faces that could have been dropped.
 // Snapping keeps shared vertices shared, so the snapped surface is closed too; the only place
 // where a back face can tie with (or, by a rounding step, beat) a front face is an edge where
 // the two meet, both of the same instance: with a uniform colour the pixel is the same either
@@ -149,8 +150,13 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       eye_(scene.camera.eye) {
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
-  glm::dmat4 projection = glm::perspective(glm::radians(cam.fovy_deg),
-                                           double(width_px) / double(height_px), cam.near, cam.far);
+  const double aspect = double(width_px) / double(height_px);
+  // Orthographic: w = 1 for every vertex, so the perspective-correct weights (lambda_i / w_i,
+  // renormalised) are the screen barycentrics, as a parallel projection needs.
+  glm::dmat4 projection =
+      cam.orthographic ? glm::ortho(-cam.ymag * aspect, cam.ymag * aspect, -cam.ymag, cam.ymag,
+                                    cam.near, cam.far)
+                       : glm::perspective(glm::radians(cam.fovy_deg), aspect, cam.near, cam.far);
   view_projection_ = projection * view;
   guard_x_ = 1.0 + 2.0 * kGuardBandPx / width_px;
   guard_y_ = 1.0 + 2.0 * kGuardBandPx / height_px;
@@ -230,6 +236,11 @@ static_assert(int(ShadingModel::Unlit) == int(LitModel::Unlit) &&
 
 void GeometryFrontEnd::prepare_lighting() {
   context_.eye_world = eye_;
+  if (scene_.camera.orthographic) {
+    // Parallel rays: every point sees the camera in the same direction.
+    context_.orthographic = true;
+    context_.to_eye = glm::normalize(scene_.camera.eye - scene_.camera.target);
+  }
   for (const Light& light : scene_.lights) {
     if (light.type == LightType::Ambient) {
       context_.ambient += glm::dvec3(light.color_linear) * light.intensity;

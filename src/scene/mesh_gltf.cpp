@@ -168,6 +168,7 @@ FileCamera file_camera(const tinygltf::Camera& camera) {
   FileCamera out;
   out.orthographic = camera.type == "orthographic";
   if (out.orthographic) {
+    out.ymag = camera.orthographic.ymag;
     out.znear = camera.orthographic.znear;
     out.zfar = camera.orthographic.zfar;
   } else {

@@ -16,10 +16,11 @@ namespace covrast::detail {
 
 /// A camera of a glTF file (glTF 2.0, 3.10), where the scene's {"gltf": N} camera comes from.
 struct FileCamera {
-  bool orthographic = false;  ///< covrast renders perspective only
-  double yfov_rad = 0.0;      ///< vertical field of view [radians]
-  double znear = 0.0;         ///< [file units]
-  double zfar = 0.0;          ///< [file units]; 0: infinite
+  bool orthographic = false;
+  double yfov_rad = 0.0;  ///< perspective: vertical field of view [radians]
+  double ymag = 0.0;      ///< orthographic: half the view's height [file units]
+  double znear = 0.0;     ///< [file units]
+  double zfar = 0.0;      ///< [file units]; 0: infinite
   /// Placed by a node of the walked scene (the first one in the walk that names it); its
   /// world transform then is `world` (the camera looks down its -z, +y up).
   bool placed = false;

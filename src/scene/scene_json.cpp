@@ -146,15 +146,14 @@ class SceneReader {
     camera.eye = vec3(required(object, "eye", "camera.eye"), "camera.eye");
     camera.target = vec3(required(object, "target", "camera.target"), "camera.target");
     camera.up = vec3(required(object, "up", "camera.up"), "camera.up");
-    camera.fovy_deg = number(required(object, "fovy_deg", "camera.fovy_deg"), "camera.fovy_deg");
+    projection(object, camera);
     camera.near = number(required(object, "near", "camera.near"), "camera.near");
     camera.far = number(required(object, "far", "camera.far"), "camera.far");
-    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
-      fail(file_, "camera.fovy_deg",
-           "must be in (0, 180) degrees, got " + shown(object["fovy_deg"]));
+    if (!(camera.near > 0.0 || (camera.orthographic && camera.near == 0.0))) {
+      fail(file_, "camera.near",
+           std::string(camera.orthographic ? "must be >= 0" : "must be > 0") + ", got " +
+               shown(object["near"]));
     }
-    if (!(camera.near > 0.0))
-      fail(file_, "camera.near", "must be > 0, got " + shown(object["near"]));
     if (!(camera.far > camera.near)) {
       fail(file_, "camera.far", "must be greater than near, got " + shown(object["far"]));
     }
@@ -167,6 +166,35 @@ class SceneReader {
       fail(file_, "camera.up", "must not be zero or parallel to the view direction");
     }
     return camera;
+  }
+
+  /// "projection": "perspective" (the default) with "fovy_deg", or "orthographic" with "ymag"
+  /// (half the view's height, world units).
+  void projection(const json& object, Camera& camera) const {
+    if (const auto it = object.find("projection"); it != object.end()) {
+      if (*it == "orthographic") {
+        camera.orthographic = true;
+      } else if (*it != "perspective") {
+        fail(file_, "camera.projection",
+             "expected \"perspective\" or \"orthographic\", got " + shown(*it));
+      }
+    }
+    if (camera.orthographic) {
+      if (object.contains("fovy_deg")) {
+        fail(file_, "camera.fovy_deg", "an orthographic camera takes ymag, not fovy_deg");
+      }
+      camera.ymag = number(required(object, "ymag", "camera.ymag"), "camera.ymag");
+      if (!(camera.ymag > 0.0)) {
+        fail(file_, "camera.ymag", "must be > 0, got " + shown(object["ymag"]));
+      }
+      return;
+    }
+    if (object.contains("ymag")) fail(file_, "camera.ymag", "only for an orthographic camera");
+    camera.fovy_deg = number(required(object, "fovy_deg", "camera.fovy_deg"), "camera.fovy_deg");
+    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
+      fail(file_, "camera.fovy_deg",
+           "must be in (0, 180) degrees, got " + shown(object["fovy_deg"]));
+    }
   }
 
   /// Row-major: 4 rows of 4 numbers, or 16 numbers in row order; translation in the last
@@ -613,7 +641,8 @@ double far_beyond_meshes(const Scene& scene, const glm::dvec3& eye, double near)
 
 /// "camera": {"gltf": N}: camera N of the scene's first glTF mesh entry, placed at its node's
 /// world transform times that entry's model matrix; it looks down its -z with +y up (glTF
-/// 2.0, 3.10.1). Only perspective cameras; aspectRatio gives way to the image's size.
+/// 2.0, 3.10.1). Perspective (yfov) or orthographic (ymag); aspectRatio and xmag give way to
+/// the image's size.
 Camera gltf_camera(const std::string& file, const json& object, const FirstGltf& first,
                    const Scene& scene) {
   if (object.size() != 1) fail(file, "camera", "with \"gltf\" give no other camera key");
@@ -630,12 +659,15 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
          which + " does not exist (" + std::to_string(cameras.size()) + " cameras)");
   }
   const detail::FileCamera& source = cameras[static_cast<std::size_t>(index)];
-  if (source.orthographic) {
-    fail(file, "camera.gltf", which + " is orthographic: covrast renders perspective only");
-  }
   if (!source.placed) fail(file, "camera.gltf", which + " is on no node of the file's scene");
-  if (!(source.yfov_rad > 0.0 && source.yfov_rad < std::numbers::pi) || !(source.znear > 0.0) ||
-      !(source.zfar == 0.0 || source.zfar > source.znear)) {
+  if (source.orthographic) {
+    if (!(source.ymag > 0.0 && std::isfinite(source.ymag)) || !(source.znear >= 0.0) ||
+        !(source.zfar > source.znear && std::isfinite(source.zfar))) {
+      fail(file, "camera.gltf",
+           which + " (orthographic) needs ymag > 0, znear >= 0 and zfar > znear");
+    }
+  } else if (!(source.yfov_rad > 0.0 && source.yfov_rad < std::numbers::pi) ||
+             !(source.znear > 0.0) || !(source.zfar == 0.0 || source.zfar > source.znear)) {
     fail(file, "camera.gltf", which + " needs 0 < yfov < pi, znear > 0 and zfar > znear");
   }
   const glm::dmat4 world = first.model * source.world;
@@ -649,7 +681,12 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
     fail(file, "camera.gltf", which + ": its node's transform is degenerate");
   }
   camera.target = camera.eye + forward / length;
-  camera.fovy_deg = glm::degrees(source.yfov_rad);
+  camera.orthographic = source.orthographic;
+  if (source.orthographic) {
+    camera.ymag = source.ymag;
+  } else {
+    camera.fovy_deg = glm::degrees(source.yfov_rad);
+  }
   camera.near = source.znear;
   camera.far = source.zfar > 0.0 ? source.zfar : far_beyond_meshes(scene, camera.eye, camera.near);
   return camera;
