@@ -314,3 +314,95 @@ TEST_CASE("bad orthographic camera keys are InputErrors", "[camera][ortho]") {
       dir.load({{"width", 8}, {"height", 8}, {"camera", ortho_camera()}, {"meshes", json::array()}})
           .camera.orthographic);
 }
+
+namespace {
+
+/// A closed cube [-1, 1]^3 moved by (2, 1, 0), as OBJ quads (counter-clockwise from outside).
+const char* kCubeObj =
+    "v 1 0 -1\nv 3 0 -1\nv 3 2 -1\nv 1 2 -1\nv 1 0 1\nv 3 0 1\nv 3 2 1\nv 1 2 1\n"
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+
+}  // namespace
+
+TEST_CASE("a mesh file without a scene: framed from +z and lit by the default rig",
+          "[cli][automatic]") {
+  TempDir dir;
+  const fs::path cube = dir.write("cube.obj", kCubeObj);
+  const covrast::Scene scene = covrast::load_mesh_scene(cube, 64, 48);
+  CHECK(scene.width == 64);
+  CHECK(scene.height == 48);
+  // Centre (2, 1, 0), bounding sphere radius sqrt(3); the vertical half angle (20 degrees) is
+  // the smaller one: distance = 1.05 sqrt(3) / sin(20 deg).
+  const double distance = 1.05 * std::sqrt(3.0) / std::sin(20.0 * kPi / 180.0);
+  CHECK(scene.camera.target == glm::dvec3(2, 1, 0));
+  CHECK(scene.camera.eye.x == 2.0);
+  CHECK(scene.camera.eye.y == 1.0);
+  CHECK(scene.camera.eye.z == Approx(distance).epsilon(1e-12));
+  CHECK(scene.camera.fovy_deg == 40.0);
+  CHECK(scene.camera.near == Approx(distance - 1.5 * std::sqrt(3.0)));
+  CHECK(scene.camera.far == Approx(distance + 1.5 * std::sqrt(3.0)));
+  // The rig, with the directional intensities divided by pi for OBJ's lambert.
+  REQUIRE(scene.lit);
+  REQUIRE(scene.lights.size() == 3);
+  CHECK(scene.lights[0].type == LightType::Directional);
+  CHECK(scene.lights[0].intensity == Approx(3.0 / kPi));
+  CHECK(scene.lights[1].intensity == Approx(1.0 / kPi));
+  CHECK(scene.lights[2].type == LightType::Ambient);
+  CHECK(scene.lights[2].intensity == 0.25);
+  // A tall image: the horizontal half angle is the smaller one.
+  const covrast::Scene tall = covrast::load_mesh_scene(cube, 20, 80);
+  const double half_h = std::atan(std::tan(20.0 * kPi / 180.0) * 0.25);
+  CHECK(tall.camera.eye.z == Approx(1.05 * std::sqrt(3.0) / std::sin(half_h)).epsilon(1e-12));
+
+  // Through the command line: the cube lies inside the image, with background all round it,
+  // and its front face (facing the camera, lit by key and fill) is lighter than the ambient.
+  const auto result = covrast::test::run_cli_in(
+      dir.path(), {"render", "cube.obj", "-o", "out.png", "--size", "64x48"}, true);
+  REQUIRE(result.exit_code == 0);
+  const covrast::Image image = covrast::read_png(dir / "out.png");
+  REQUIRE(image.width == 64);
+  REQUIRE(image.height == 48);
+  int border_not_background = 0;
+  for (int x = 0; x < 64; ++x) {
+    for (int y = 0; y < 48; ++y) {
+      if (x != 0 && x != 63 && y != 0 && y != 47) continue;
+      const std::uint8_t* p = image.pixel(x, y);
+      border_not_background += p[0] != 46 || p[1] != 46 || p[2] != 51;  // sRGB (0.18, 0.18, 0.2)
+    }
+  }
+  CHECK(border_not_background == 0);
+  // The front face: 0.25 + (3 x 0.572 + (0.8, 0.85, 1) x 0.620) / pi = 0.95 .. 0.99.
+  for (int c = 0; c < 3; ++c) CHECK(int(image.pixel(32, 24)[c]) > 240);
+  const auto missing =
+      covrast::test::run_cli_in(dir.path(), {"render", "gone.glb", "-o", "x.png"}, true);
+  CHECK(missing.exit_code == 2);
+  CHECK_THAT(missing.err, Contains("gone.glb: cannot open: No such file or directory"));
+}
+
+TEST_CASE("a glTF file without a scene: its camera and its lights when it has them",
+          "[cli][automatic]") {
+  TempDir dir;
+  GltfBuilder b = lights_file();
+  b.gltf["cameras"] = {
+      {{"type", "perspective"}, {"perspective", {{"yfov", 0.5}, {"znear", 0.5}, {"zfar", 50}}}}};
+  b.gltf["nodes"].push_back({{"translation", {0, 0, 7}}, {"camera", 0}});
+  b.gltf["scenes"][0]["nodes"].push_back(5);
+  const covrast::Scene scene = covrast::load_mesh_scene(dir.write("lit.glb", b.glb()));
+  CHECK(scene.width == 640);
+  CHECK(scene.height == 360);
+  CHECK(scene.camera.eye == glm::dvec3(0, 0, 7));
+  CHECK(scene.camera.fovy_deg == Approx(0.5 * 180 / kPi));
+  REQUIRE(scene.lights.size() == 3);  // the file's, no rig
+  CHECK(scene.lights[1].type == LightType::Point);
+  CHECK(scene.lights[1].position == glm::dvec3(1, 0, 2));
+  // Without lights and camera: the rig at pbr intensities, and the framing camera.
+  const covrast::Scene plain =
+      covrast::load_mesh_scene(dir.write("plain.glb", square_file().glb()));
+  REQUIRE(plain.lights.size() == 3);
+  CHECK(plain.lights[0].intensity == 3.0);
+  CHECK(plain.lights[1].intensity == 1.0);
+  CHECK(plain.camera.target == glm::dvec3(0, 0, 0));
+  CHECK(plain.camera.eye.z == Approx(1.05 * std::sqrt(2.0) / std::sin(20.0 * kPi / 180.0)));
+  CHECK_THROWS_WITH(covrast::load_mesh_scene(dir.write("a.stl", "solid")),
+                    Contains("a.stl: unknown mesh format"));
+}

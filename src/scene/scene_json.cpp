@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <map>
@@ -743,13 +744,19 @@ Scene load_scene(const std::filesystem::path& json_path) {
   return load_scene(json_path, meshes);
 }
 
-Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
-  const std::string file = json_path.string();
-  const json root = read_scene_root(json_path, file);
+namespace {
+
+using MeshFiles = std::map<std::pair<std::string, MeshFormat>, CachedMesh>;
+
+/// load_scene's work on a parsed root: `file` names it in messages, mesh paths are relative to
+/// `base_dir`, meshes come from and go to `files`. `cameras`, if given, receives the first glTF
+/// entry's cameras (load_mesh_scene looks for one there).
+Scene scene_from_root(const json& root, const std::string& file,
+                      const std::filesystem::path& base_dir, MeshFiles& files,
+                      std::vector<detail::FileCamera>* cameras) {
   const SceneReader reader(file);
 
   Scene scene;
-  scene.source = json_path;
   scene.width = reader.image_side(root, "width");
   scene.height = reader.image_side(root, "height");
   if (const auto it = root.find("background"); it != root.end()) {
@@ -766,7 +773,7 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  SceneMeshes cache(file, json_path.parent_path(), mesh_files.impl_->files);
+  SceneMeshes cache(file, base_dir, files);
   FirstGltf first_gltf;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
     const std::string key = "meshes[" + std::to_string(i) + "]";
@@ -778,6 +785,64 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
     scene.lights.insert(scene.lights.begin() + std::ptrdiff_t(*gltf_lights_at), lights.begin(),
                         lights.end());
   }
+  if (cameras != nullptr && first_gltf.loaded != nullptr) *cameras = first_gltf.loaded->cameras;
+  return scene;
+}
+
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
+  const std::string file = json_path.string();
+  const json root = read_scene_root(json_path, file);
+  Scene scene =
+      scene_from_root(root, file, json_path.parent_path(), mesh_files.impl_->files, nullptr);
+  scene.source = json_path;
+  return scene;
+}
+
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height) {
+  const std::string file = mesh_path.string();
+  std::string ext = mesh_path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
+    throw InputError(file + ": unknown mesh format (expected .obj, .gltf or .glb)");
+  }
+  std::string bytes, error;
+  if (!detail::read_whole_file(mesh_path, bytes, error)) {
+    throw InputError(file + ": cannot open: " + error);
+  }
+  const bool gltf = ext != ".obj";
+  // The file as a one-entry scene, through the scene loader and its checks; the camera is a
+  // placeholder until the file's own or the framing one replaces it.
+  json root = {{"width", width},
+               {"height", height},
+               {"background", {0.18, 0.18, 0.2}},
+               {"camera",
+                {{"eye", {0, 0, 1}},
+                 {"target", {0, 0, 0}},
+                 {"up", {0, 1, 0}},
+                 {"fovy_deg", 40},
+                 {"near", 0.1},
+                 {"far", 10}}},
+               {"meshes", json::array({{{gltf ? "gltf" : "obj", mesh_path.filename().string()}}})}};
+  if (gltf) root["lights"] = "gltf";
+  MeshFiles files;  // the second pass below takes the parsed file from here
+  std::vector<detail::FileCamera> cameras;
+  Scene scene = scene_from_root(root, file, mesh_path.parent_path(), files, &cameras);
+  const auto placed = std::find_if(cameras.begin(), cameras.end(),
+                                   [](const detail::FileCamera& c) { return c.placed; });
+  if (placed != cameras.end()) {
+    root["camera"] = {{"gltf", static_cast<std::uint64_t>(placed - cameras.begin())}};
+    scene = scene_from_root(root, file, mesh_path.parent_path(), files, nullptr);
+  } else {
+    scene.camera = detail::framing_camera(scene);
+  }
+  if (scene.lights.empty()) {
+    for (const Light& light : detail::default_light_rig(gltf)) add_light(scene, light);
+  }
+  scene.lit = true;
+  scene.source = mesh_path;
   return scene;
 }
 
