@@ -406,3 +406,75 @@ TEST_CASE("a glTF file without a scene: its camera and its lights when it has th
   CHECK_THROWS_WITH(covrast::load_mesh_scene(dir.write("a.stl", "solid")),
                     Contains("a.stl: unknown mesh format"));
 }
+
+namespace {
+
+/// Two squares side by side facing +z: x in [-2, -0.5] with material 0, x in [0.5, 2] with
+/// material 1.
+GltfBuilder two_squares(bool double_sided_0, bool double_sided_1) {
+  GltfBuilder b;
+  const int left = b.add_floats({-2, -1, 0, -0.5f, -1, 0, -2, 1, 0, -0.5f, 1, 0}, "VEC3");
+  const int right = b.add_floats({0.5f, -1, 0, 2, -1, 0, 0.5f, 1, 0, 2, 1, 0}, "VEC3");
+  b.gltf["materials"] = {{{"doubleSided", double_sided_0}}, {{"doubleSided", double_sided_1}}};
+  b.single_mesh({{{"attributes", {{"POSITION", left}}}, {"mode", 5}, {"material", 0}},
+                 {{"attributes", {{"POSITION", right}}}, {"mode", 5}, {"material", 1}}});
+  return b;
+}
+
+/// How many pixels are not background in the left and the right half of the image.
+std::pair<int, int> covered_halves(const covrast::Image& image) {
+  std::pair<int, int> count{0, 0};
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = 0; x < image.width; ++x) {
+      const std::uint8_t* p = image.pixel(x, y);
+      if (p[0] != 0 || p[1] != 0 || p[2] != 0) (x < image.width / 2 ? count.first : count.second)++;
+    }
+  }
+  return count;
+}
+
+}  // namespace
+
+TEST_CASE("back faces of single-sided glTF materials are culled in every mode",
+          "[gltf][single_sided]") {
+  TempDir dir;
+  dir.write("one.glb", two_squares(false, false).glb());
+  dir.write("mixed.glb", two_squares(false, true).glb());
+  dir.write("both.glb", two_squares(true, true).glb());
+  const auto scene = [&](const char* file, double eye_z, const json& extra, bool lit) {
+    json entry = {{"gltf", file}, {"color", {1, 1, 1}}};
+    entry.update(extra);
+    json camera = camera_json();
+    camera["eye"] = {0, 0, eye_z};
+    json s = {{"width", 40}, {"height", 20}, {"camera", camera}, {"meshes", json::array({entry})}};
+    if (lit) s["lights"] = {{{"type", "ambient"}, {"intensity", 1}}};
+    return dir.load(s);
+  };
+  const json mirror = {{"model", {{-1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}}};
+  for (const char* mode :
+       {"coverage", "coverage-blend", "aliased", "msaa:4", "ssaa:4", "reference"}) {
+    for (const bool lit : {false, true}) {
+      INFO(mode << (lit ? " lit" : " unlit"));
+      // From the front both squares show; from behind single-sided ones vanish.
+      const auto front = covered_halves(render(scene("one.glb", 3, json::object(), lit), mode));
+      CHECK(front.first > 50);
+      CHECK(front.second > 50);
+      CHECK(covered_halves(render(scene("one.glb", -3, json::object(), lit), mode)) ==
+            std::pair<int, int>{0, 0});
+      // Per material: seen from behind (x flips on screen) only the double-sided right square
+      // shows, now in the left half.
+      const auto mixed = covered_halves(render(scene("mixed.glb", -3, json::object(), lit), mode));
+      CHECK(mixed == std::pair<int, int>{front.second, 0});
+      CHECK(covered_halves(render(scene("both.glb", -3, json::object(), lit), mode)) ==
+            std::pair<int, int>{front.second, front.first});
+      // A mirroring model matrix keeps the front facing +z (clockwise on screen now).
+      CHECK(covered_halves(render(scene("one.glb", 3, mirror, lit), mode)) ==
+            std::pair<int, int>{front.second, front.first});
+      CHECK(covered_halves(render(scene("one.glb", -3, mirror, lit), mode)) ==
+            std::pair<int, int>{0, 0});
+      // The scene may make them double-sided.
+      const json both_sides = {{"material", {{"double_sided", true}}}};
+      CHECK(covered_halves(render(scene("one.glb", -3, both_sides, lit), mode)).first > 50);
+    }
+  }
+}

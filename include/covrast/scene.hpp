@@ -53,8 +53,7 @@ struct Material {
   float shininess = 32.0f;          ///< blinn-phong exponent, > 0
   glm::vec3 specular_linear{0.5f};  ///< blinn-phong specular colour, linear
   /// Back faces are lit with the flipped normal (glTF doubleSided). A single-sided
-  /// material lights them with the normal as it is (glTF would cull them; covrast draws
-  /// them, see docs/shading.md).
+  /// material's back faces are not drawn, lit or unlit, in every mode (glTF 2.0, 3.9.5).
   bool double_sided = true;
   /// Opacity, 0..1 (OBJ's MTL `d`); stored for the alpha modes, not used by shading yet.
   double base_alpha = 1.0;

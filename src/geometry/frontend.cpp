@@ -182,6 +182,49 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
     }
   }
   if (scene.lit) prepare_lighting();
+  prepare_single_sided();
+}
+
+void GeometryFrontEnd::prepare_single_sided() {
+  single_sided_kind_.assign(scene_.meshes.size(), 0);
+  single_sided_triangles_.resize(scene_.meshes.size());
+  for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
+    const std::vector<Material>& materials = scene_.meshes[i].materials;
+    std::size_t single = 0;
+    for (const Material& m : materials) single += m.double_sided ? 0 : 1;
+    if (single == 0) continue;
+    const MeshData& mesh = *scene_.meshes[i].mesh;
+    // All single-sided, or one material for every triangle (triangle_materials empty: all
+    // use materials[0]): the whole instance; else a flag per triangle from its material.
+    if (single == materials.size()) {
+      single_sided_kind_[i] = 1;
+      continue;
+    }
+    if (mesh.triangle_materials.empty()) {
+      single_sided_kind_[i] = materials[0].double_sided ? 0 : 1;
+      continue;
+    }
+    single_sided_kind_[i] = 2;
+    std::vector<std::uint8_t>& flags = single_sided_triangles_[i];
+    flags.resize(mesh.triangle_count());
+    for (std::size_t t = 0; t < flags.size(); ++t) {
+      flags[t] = materials[mesh.triangle_materials[t]].double_sided ? 0 : 1;
+    }
+  }
+}
+
+void GeometryFrontEnd::set_single_sided(std::size_t instance, Sink& sink) const {
+  sink.cull_facing = 0;
+  sink.single_sided = nullptr;
+  if (single_sided_kind_[instance] == 0) return;
+  // A back face is the file's counter-clockwise front turned away: clockwise on screen, or
+  // counter-clockwise under a mirroring model matrix (the normal flip in emit_triangle).
+  const bool mirrored = glm::determinant(glm::dmat3(scene_.meshes[instance].model)) < 0.0;
+  sink.cull_facing = mirrored ? kDropCounterClockwise : kDropClockwise;
+  sink.first_primitive = first_triangle_[instance];
+  if (single_sided_kind_[instance] == 2) {
+    sink.single_sided = single_sided_triangles_[instance].data();
+  }
 }
 
 namespace {
@@ -466,6 +509,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
     sink.convex_surface = convex_surface(instance);
+    set_single_sided(instance, sink);
     if (instance_lit(instance)) {
       setup_lit_run(instance, g, run_end, sink);
       g = run_end;
@@ -543,9 +587,16 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   // CCW in NDC (y up) is negative area with y down. Checked after the image test, so that
   // backface_culled counts exactly the triangles that culling keeps from binning.
   const bool front = area2 < 0;
-  if ((sink.drop_facing & (front ? kDropCounterClockwise : kDropClockwise)) != 0) {
+  const unsigned facing = front ? kDropCounterClockwise : kDropClockwise;
+  if ((sink.drop_facing & facing) != 0) {
     ++sink.counters.culled;
     ++sink.counters.backface_culled;
+    return;
+  }
+  // glTF 2.0, 3.9.5: the back faces of a single-sided material are not drawn.
+  if ((sink.cull_facing & facing) != 0 &&
+      (sink.single_sided == nullptr || sink.single_sided[primitive - sink.first_primitive] != 0)) {
+    ++sink.counters.culled;
     return;
   }
   if (sink.bounds != nullptr) {
