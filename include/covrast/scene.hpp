@@ -44,14 +44,17 @@ inline constexpr std::uint64_t kMaxSceneLights = 1024;
 inline constexpr std::uint64_t kMaxObjFaceCorners = std::uint64_t(1) << 16;
 
 /// OpenGL conventions: view = lookAt(eye, target, up), projection =
-/// perspective(fovy, width / height of the output image, near, far), clip z in [-w, w].
+/// perspective(fovy, width / height of the output image, near, far), or for an orthographic
+/// camera ortho(-ymag x aspect, ymag x aspect, -ymag, ymag, near, far); clip z in [-w, w].
 struct Camera {
   glm::dvec3 eye{0.0, 0.0, 3.0};
   glm::dvec3 target{0.0, 0.0, 0.0};
   glm::dvec3 up{0.0, 1.0, 0.0};
-  double fovy_deg = 45.0;  ///< vertical field of view [degrees], in (0, 180)
-  double near = 0.1;       ///< near plane distance [world units], > 0
-  double far = 100.0;      ///< far plane distance [world units], > near
+  double fovy_deg = 45.0;     ///< vertical field of view [degrees], in (0, 180); perspective
+  double near = 0.1;          ///< near plane distance [world units], > 0 (orthographic: >= 0)
+  double far = 100.0;         ///< far plane distance [world units], > near
+  bool orthographic = false;  ///< parallel projection: ymag instead of fovy_deg
+  double ymag = 1.0;          ///< orthographic: half the view's height [world units], > 0
 };
 
 /// How a lit surface reflects light (docs/shading.md has every formula and its source).
@@ -80,8 +83,7 @@ struct Material {
   float shininess = 32.0f;          ///< blinn-phong exponent, > 0
   glm::vec3 specular_linear{0.5f};  ///< blinn-phong specular colour, linear
   /// Back faces are lit with the flipped normal (glTF doubleSided). A single-sided
-  /// material lights them with the normal as it is (glTF would cull them; covrast draws
-  /// them, see docs/shading.md).
+  /// material's back faces are not drawn, lit or unlit, in every mode (glTF 2.0, 3.9.5).
   bool double_sided = true;
   // Textures (docs/textures.md); an empty slot changes nothing. baseColor multiplies the base
   // colour (its alpha is kept for alpha modes); metallicRoughness: B x metallic, G x
@@ -95,8 +97,11 @@ struct Material {
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
-  /// alpha (MeshData::color_alphas) and, later, the base colour texture's alpha.
+  /// alpha (MeshData::color_alphas) and the base colour texture's alpha.
   double base_alpha = 1.0;
+  /// The base colour texture's file (OBJ's MTL `map_Kd`, resolved against the .mtl file's
+  /// directory); empty if none. The OBJ loader turns it into base_color_texture.
+  std::string base_color_texture_path;
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
@@ -246,6 +251,13 @@ class MeshFileCache {
 /// load_scene, taking the meshes from `mesh_files` and adding the ones it loads. Each scene
 /// gets the warnings of the files it uses, whether loaded now or before.
 Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files);
+
+/// A lit scene of one mesh file without a scene file (`covrast render model.glb`): the file's
+/// first camera that a node places, else a camera framing the model from +z (fovy 40 degrees);
+/// the file's KHR_lights_punctual lights, else a default rig of a key, a fill and an ambient
+/// light; the file's materials (OBJ without materials: lambert). docs/scene-format.md,
+/// "Rendering a mesh file without a scene", has the numbers. Throws InputError as load_scene.
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360);
 
 /// Loads one mesh file (.obj, .gltf, .glb) by itself; used by load_scene and tests.
 /// For glTF the node transforms are baked into the positions and COLOR_0 x

@@ -116,6 +116,11 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
   j["camera"] = {{"eye", vec_json(scene.camera.eye)}, {"target", vec_json(scene.camera.target)},
                  {"up", vec_json(scene.camera.up)},   {"fovy_deg", scene.camera.fovy_deg},
                  {"near", scene.camera.near},         {"far", scene.camera.far}};
+  if (scene.camera.orthographic) {
+    j["camera"].erase("fovy_deg");
+    j["camera"]["projection"] = "orthographic";
+    j["camera"]["ymag"] = scene.camera.ymag;
+  }
   nlohmann::ordered_json meshes = nlohmann::ordered_json::array();
   for (const MeshInstance& instance : scene.meshes) {
     nlohmann::ordered_json m = {{"source", mesh_source(instance)},
@@ -154,8 +159,10 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
             << "background:  " << vec_text(glm::dvec3(scene.background_linear)) << " (linear)\n"
             << "camera:      eye " << vec_text(c.eye) << ", target " << vec_text(c.target)
             << ", up " << vec_text(c.up) << '\n'
-            << "             fovy " << format_number(c.fovy_deg) << " deg, near "
-            << format_number(c.near) << ", far " << format_number(c.far) << '\n'
+            << "             "
+            << (c.orthographic ? "orthographic, ymag " + format_number(c.ymag)
+                               : "fovy " + format_number(c.fovy_deg) + " deg")
+            << ", near " << format_number(c.near) << ", far " << format_number(c.far) << '\n'
             << "meshes:      " << scene.meshes.size() << '\n';
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];

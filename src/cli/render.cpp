@@ -15,7 +15,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <charconv>
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <tuple>
@@ -75,7 +77,9 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       "render",
       "Render a JSON scene to a PNG (8-bit sRGB). The output is written atomically: on any "
       "error nothing is created and an existing file is left untouched.");
-  sub->add_option("scene", args.scene, "Scene file (JSON, see docs/scene-format.md)")
+  sub->add_option("scene", args.scene,
+                  "Scene file (JSON, see docs/scene-format.md), or a mesh file (.obj, .gltf, "
+                  ".glb) to render framed and lit without a scene file")
       ->required()
       ->type_name("SCENE.json");
   sub->add_option("-o,--output", args.output, "Output PNG file")->required()->type_name("OUT.png");
@@ -135,6 +139,18 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
   return sub;
 }
 
+namespace {
+
+/// A mesh file by its extension (any case): rendered without a scene file (load_mesh_scene).
+bool is_mesh_file(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".obj" || ext == ".gltf" || ext == ".glb";
+}
+
+}  // namespace
+
 int run_render(const RenderArgs& args) {
   RenderOptions options;
   options.mode = parse_render_mode(args.mode);
@@ -153,7 +169,10 @@ int run_render(const RenderArgs& args) {
   check_output_path(args.output, {".png"});
   if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});
 
-  const Scene scene = load_scene(args.scene);
+  const Scene scene = is_mesh_file(args.scene)
+                          ? load_mesh_scene(args.scene, options.width > 0 ? options.width : 640,
+                                            options.height > 0 ? options.height : 360)
+                          : load_scene(args.scene);
   for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
   if (args.strict && !scene.warnings.empty()) {
     throw InputError(args.scene + ": " + std::to_string(scene.warnings.size()) +

@@ -141,7 +141,8 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
   const ShadingContext& c = *s.context;
   const glm::dvec3 to_eye = c.eye_world - p;
   const double eye_distance = glm::length(to_eye);
-  const glm::dvec3 v = eye_distance > 0.0 ? to_eye * (1.0 / eye_distance) : n;
+  glm::dvec3 v = eye_distance > 0.0 ? to_eye * (1.0 / eye_distance) : n;
+  if (c.orthographic) v = c.to_eye;
   switch (s.model) {
     case LitModel::Unlit:
       return base;

@@ -37,6 +37,9 @@ struct PunctualLight {
 /// The frame's lights and eye: one per front end, shared by every lit triangle.
 struct ShadingContext {
   glm::dvec3 eye_world{0.0};
+  /// Orthographic camera: v is `to_eye` (unit, towards the camera) at every point.
+  bool orthographic = false;
+  glm::dvec3 to_eye{0.0, 0.0, 1.0};
   glm::dvec3 ambient{0.0};  ///< sum of the ambient lights' color x intensity
   std::vector<PunctualLight> lights;
 };

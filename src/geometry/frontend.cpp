@@ -131,9 +131,10 @@ inline SnappedVertex snapped_vertex(double x_fx8, double y_fx8, double z_window,
 // s_world > 0, so the dropped facing is clockwise (front_facing false) for s_world > 0 and
 // counter-clockwise for s_world < 0.
 // With a perspective camera, (c) alone already puts the eye outside the mesh's convex hull
-// (every vertex is at least `near` in front of it); (b) is a cheap second guard. covrast's
-// camera is perspective only; an orthographic one would have the eye at infinity and parallel
-// rays that start on the near plane, so (c) alone would suffice there and (b) would drop out.
+// (every vertex is at least `near` in front of it); (b) is a cheap second guard. With an
+// orthographic camera the rays are parallel and start on the near plane, and (c) puts every
+// vertex beyond it, so every ray starts outside the surface by (c) alone; (b), still tested,
+// can then only keep back faces that could have been dropped.
 // Snapping keeps shared vertices shared, so the snapped surface is closed too; the only place
 // where a back face can tie with (or, by a rounding step, beat) a front face is an edge where
 // the two meet, both of the same instance: with a uniform colour the pixel is the same either
@@ -153,8 +154,13 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       eye_(scene.camera.eye) {
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
-  glm::dmat4 projection = glm::perspective(glm::radians(cam.fovy_deg),
-                                           double(width_px) / double(height_px), cam.near, cam.far);
+  const double aspect = double(width_px) / double(height_px);
+  // Orthographic: w = 1 for every vertex, so the perspective-correct weights (lambda_i / w_i,
+  // renormalised) are the screen barycentrics, as a parallel projection needs.
+  glm::dmat4 projection =
+      cam.orthographic ? glm::ortho(-cam.ymag * aspect, cam.ymag * aspect, -cam.ymag, cam.ymag,
+                                    cam.near, cam.far)
+                       : glm::perspective(glm::radians(cam.fovy_deg), aspect, cam.near, cam.far);
   view_projection_ = projection * view;
   guard_x_ = 1.0 + 2.0 * kGuardBandPx / width_px;
   guard_y_ = 1.0 + 2.0 * kGuardBandPx / height_px;
@@ -186,6 +192,49 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
     }
   }
   if (scene.lit || any_alpha || shows_textures(scene)) prepare_lighting();
+  prepare_single_sided();
+}
+
+void GeometryFrontEnd::prepare_single_sided() {
+  single_sided_kind_.assign(scene_.meshes.size(), 0);
+  single_sided_triangles_.resize(scene_.meshes.size());
+  for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
+    const std::vector<Material>& materials = scene_.meshes[i].materials;
+    std::size_t single = 0;
+    for (const Material& m : materials) single += m.double_sided ? 0 : 1;
+    if (single == 0) continue;
+    const MeshData& mesh = *scene_.meshes[i].mesh;
+    // All single-sided, or one material for every triangle (triangle_materials empty: all
+    // use materials[0]): the whole instance; else a flag per triangle from its material.
+    if (single == materials.size()) {
+      single_sided_kind_[i] = 1;
+      continue;
+    }
+    if (mesh.triangle_materials.empty()) {
+      single_sided_kind_[i] = materials[0].double_sided ? 0 : 1;
+      continue;
+    }
+    single_sided_kind_[i] = 2;
+    std::vector<std::uint8_t>& flags = single_sided_triangles_[i];
+    flags.resize(mesh.triangle_count());
+    for (std::size_t t = 0; t < flags.size(); ++t) {
+      flags[t] = materials[mesh.triangle_materials[t]].double_sided ? 0 : 1;
+    }
+  }
+}
+
+void GeometryFrontEnd::set_single_sided(std::size_t instance, Sink& sink) const {
+  sink.cull_facing = 0;
+  sink.single_sided = nullptr;
+  if (single_sided_kind_[instance] == 0) return;
+  // A back face is the file's counter-clockwise front turned away: clockwise on screen, or
+  // counter-clockwise under a mirroring model matrix (the normal flip in emit_triangle).
+  const bool mirrored = glm::determinant(glm::dmat3(scene_.meshes[instance].model)) < 0.0;
+  sink.cull_facing = mirrored ? kDropCounterClockwise : kDropClockwise;
+  sink.first_primitive = first_triangle_[instance];
+  if (single_sided_kind_[instance] == 2) {
+    sink.single_sided = single_sided_triangles_[instance].data();
+  }
 }
 
 namespace {
@@ -275,6 +324,11 @@ static_assert(int(AlphaMode::Opaque) == int(TriangleAlpha::Opaque) &&
 
 void GeometryFrontEnd::prepare_lighting() {
   context_.eye_world = eye_;
+  if (scene_.camera.orthographic) {
+    // Parallel rays: every point sees the camera in the same direction.
+    context_.orthographic = true;
+    context_.to_eye = glm::normalize(scene_.camera.eye - scene_.camera.target);
+  }
   for (const Light& light : scene_.lights) {
     if (light.type == LightType::Ambient) {
       context_.ambient += glm::dvec3(light.color_linear) * light.intensity;
@@ -515,6 +569,7 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
     const glm::dmat4 mvp = view_projection_ * inst.model;
     sink.drop_facing = drop_facing(instance);
     sink.convex_surface = convex_surface(instance);
+    set_single_sided(instance, sink);
     if (instance_lit(instance) || instance_alpha(instance)) {
       setup_lit_run(instance, g, run_end, sink);
       g = run_end;
@@ -592,9 +647,16 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   // CCW in NDC (y up) is negative area with y down. Checked after the image test, so that
   // backface_culled counts exactly the triangles that culling keeps from binning.
   const bool front = area2 < 0;
-  if ((sink.drop_facing & (front ? kDropCounterClockwise : kDropClockwise)) != 0) {
+  const unsigned facing = front ? kDropCounterClockwise : kDropClockwise;
+  if ((sink.drop_facing & facing) != 0) {
     ++sink.counters.culled;
     ++sink.counters.backface_culled;
+    return;
+  }
+  // glTF 2.0, 3.9.5: the back faces of a single-sided material are not drawn.
+  if ((sink.cull_facing & facing) != 0 &&
+      (sink.single_sided == nullptr || sink.single_sided[primitive - sink.first_primitive] != 0)) {
+    ++sink.counters.culled;
     return;
   }
   if (sink.bounds != nullptr) {

@@ -211,6 +211,13 @@ class GeometryFrontEnd {
     /// The instance's model matrix has a negative determinant: its front faces (counter-
     /// clockwise in the file) are clockwise on screen.
     bool mirrored = false;
+    /// Back faces of single-sided materials (glTF doubleSided false), culled in every mode:
+    /// the instance's back facing (kDropClockwise, or kDropCounterClockwise when mirrored) or
+    /// 0; `single_sided`, when not null, flags which of the instance's triangles (indexed
+    /// from `first_primitive`) have such a material, else all have.
+    unsigned cull_facing = 0;
+    const std::uint8_t* single_sided = nullptr;
+    std::uint64_t first_primitive = 0;
     /// A new triangle at the end of the output, its fields to be written.
     TriangleSetup& next() { return chunk != nullptr ? chunk->emplace_back() : out->emplace_back(); }
   };
@@ -283,6 +290,12 @@ class GeometryFrontEnd {
   // m, pointing at context_; chunk_shading_[c]: the records of chunk c, written
   // only by setup_chunk(c).
   ShadingContext context_;
+  /// Single-sided materials per instance (set_single_sided): 0 none, 1 all, 2 some, with
+  /// single_sided_triangles_[instance] flagging each triangle then.
+  void prepare_single_sided();
+  void set_single_sided(std::size_t instance, Sink& sink) const;
+  std::vector<std::uint8_t> single_sided_kind_;
+  std::vector<std::vector<std::uint8_t>> single_sided_triangles_;
   std::vector<std::vector<SurfaceShading>> surfaces_;
   /// textures_[i][m]: instance i's material m's slots, where
   /// surfaces_[i][m].textures points.

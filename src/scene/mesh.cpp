@@ -155,7 +155,7 @@ std::shared_ptr<MeshData> load_mesh(const std::filesystem::path& path) {
   if (!detail::read_whole_file(path, bytes, error)) {
     throw InputError(name + ": cannot open: " + error);
   }
-  if (ext == ".obj") return detail::parse_obj(bytes, name).data;
+  if (ext == ".obj") return detail::parse_obj(bytes, name, path.parent_path()).data;
   return detail::parse_gltf(bytes, name, path.parent_path()).data;
 }
 

@@ -11,6 +11,7 @@
 #include "scene/gltf_accessors.hpp"
 #include "scene/gltf_draco.hpp"
 #include "scene/gltf_input.hpp"
+#include "scene/gltf_lights.hpp"
 #include "scene/gltf_pose.hpp"
 #include "scene/gltf_textures.hpp"
 #include "scene/scene_internal.hpp"
@@ -169,6 +170,7 @@ FileCamera file_camera(const tinygltf::Camera& camera) {
   FileCamera out;
   out.orthographic = camera.type == "orthographic";
   if (out.orthographic) {
+    out.ymag = camera.orthographic.ymag;
     out.znear = camera.orthographic.znear;
     out.zfar = camera.orthographic.zfar;
   } else {
@@ -220,9 +222,10 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 6> kImplementedExtensions = {
+constexpr std::array<std::string_view, 7> kImplementedExtensions = {
     kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
-    "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform"};
+    "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform",
+    kLightsExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -314,12 +317,15 @@ class GltfMeshBuilder {
       const tinygltf::Node& node = model_.nodes[static_cast<std::size_t>(node_index)];
       if (node.mesh >= 0) add_mesh(node_index, node.mesh, node_placement(node_index));
       if (node.camera >= 0) place_camera(node_index, node.camera);
+      const glm::dmat4& world = node_world_[static_cast<std::size_t>(node_index)];
+      if (auto light = node_light(model_, node_index, world, name_)) lights_.push_back(*light);
     }
   }
 
   LoadedMesh finish() {
     LoadedMesh loaded;
     loaded.cameras = std::move(cameras_);
+    loaded.lights = std::move(lights_);
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
@@ -874,6 +880,7 @@ class GltfMeshBuilder {
   bool any_normals_ = false;
   std::size_t missing_texcoords_ = 0;  ///< primitives sampling a UV set they lack
   std::vector<FileCamera> cameras_;
+  std::vector<FileLight> lights_;       ///< KHR_lights_punctual, in walk order
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space
   std::vector<bool> reached_;           ///< per node: in the walked scene
   /// Primitives of the modes POINTS, LINES, LINE_LOOP, LINE_STRIP (0..3), counted once per

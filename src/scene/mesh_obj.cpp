@@ -1,10 +1,14 @@
-// Wavefront OBJ reader for the subset covrast renders: "v x y z [r g b]", "vn x y z" and "f"
-// with any index form (i, i/t, i//n, i/t/n; negative = relative to the vertices or normals
-// defined so far). Polygons become the fan (0, k, k + 1), k = 1 .. n - 2, triangles in file
-// order; normals become corner normals (MeshData::corner_normals), "vt u [v [w]]" corner UVs
-// (MeshData::corner_texcoords[0], v flipped to glTF's convention: OBJ's v = 0 is the bottom
-// of the image). Everything else (o, g, s, usemtl, mtllib, l, ...) is ignored, so a missing
-// .mtl file never matters.
+// Wavefront OBJ reader for the subset covrast renders: "v x y z [r g b]", "vn x y z", "f" with
+// any index form (i, i/t, i//n, i/t/n; negative = relative to the vertices or normals defined
+// so far), and materials ("mtllib", "usemtl"; obj_material.cpp). Convex polygons become the
+// fan (0, k, k + 1), k = 1 .. n - 2, concave ones are ear-clipped (obj_polygon.cpp);
+// triangles in file order; normals become corner normals (MeshData::corner_normals), "vt u [v
+// [w]]" corner UVs (MeshData::corner_texcoords[0], v flipped to glTF's convention: OBJ's v = 0
+// is the bottom of the image). "l" and "p" are counted in a warning; the rest (o, g, s, ...)
+// carries nothing covrast draws.
+#include "scene/obj_material.hpp"
+#include "scene/obj_polygon.hpp"
+#include "scene/obj_text.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <algorithm>
@@ -13,6 +17,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
+#include <map>
 #include <vector>
 
 namespace covrast::detail {
@@ -20,72 +25,8 @@ namespace {
 
 constexpr std::size_t kMaxVertices = std::numeric_limits<std::uint32_t>::max();
 
-bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-
-/// Splits one line into whitespace-separated tokens.
-class Tokens {
- public:
-  explicit Tokens(std::string_view line) : rest_(line) {}
-  bool next(std::string_view& token) {
-    std::size_t begin = 0;
-    while (begin < rest_.size() && is_blank(rest_[begin])) ++begin;
-    std::size_t end = begin;
-    while (end < rest_.size() && !is_blank(rest_[end])) ++end;
-    token = rest_.substr(begin, end - begin);
-    rest_.remove_prefix(end);
-    return !token.empty();
-  }
-
- private:
-  std::string_view rest_;
-};
-
-/// A token as it may appear in a one-line message: printable ASCII, shortened.
-std::string printable(std::string_view token) {
-  constexpr std::size_t kMaxShown = 32;
-  std::string out;
-  for (std::size_t i = 0; i < token.size() && i < kMaxShown; ++i) {
-    const unsigned char c = static_cast<unsigned char>(token[i]);
-    out += (c >= 0x20 && c < 0x7f) ? static_cast<char>(c) : '?';
-  }
-  if (token.size() > kMaxShown) out += "...";
-  return out;
-}
-
 [[noreturn]] void fail(const std::string& name, std::size_t line, const std::string& message) {
-  throw InputError(name + ":" + std::to_string(line) + ": " + message);
-}
-
-/// from_chars rejects a leading '+', which some exporters write.
-std::string_view strip_plus(std::string_view token) {
-  if (token.size() >= 2 && token[0] == '+' && token[1] != '-' && token[1] != '+') {
-    token.remove_prefix(1);
-  }
-  return token;
-}
-
-bool parse_double(std::string_view token, double& value) {
-  token = strip_plus(token);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  if (ptr != end) return false;
-  if (ec == std::errc::result_out_of_range) {
-    // Overflow must become +-inf (and the triangle is then dropped), underflow 0: strtod does
-    // exactly that, from_chars leaves the value untouched.
-    const std::string copy(token);
-    value = std::strtod(copy.c_str(), nullptr);
-    return true;
-  }
-  return ec == std::errc();
-}
-
-bool parse_integer(std::string_view token, long long& value) {
-  token = strip_plus(token);
-  if (token.empty()) return false;
-  const char* end = token.data() + token.size();
-  const auto [ptr, ec] = std::from_chars(token.data(), end, value);
-  return ec == std::errc() && ptr == end;
+  fail_at(name, line, message);
 }
 
 std::string out_of_range(long long index, std::size_t vertex_count) {
@@ -181,7 +122,8 @@ void resolve_corner_normals(const std::vector<long long>& refs,
 /// One OBJ file's statements, read line by line into a MeshData.
 class ObjParser {
  public:
-  explicit ObjParser(const std::string& name) : name_(name), mesh_(std::make_shared<MeshData>()) {
+  ObjParser(const std::string& name, const std::filesystem::path& base_dir)
+      : name_(name), base_dir_(base_dir), mesh_(std::make_shared<MeshData>()) {
     mesh_->source = name;
   }
 
@@ -201,11 +143,19 @@ class ObjParser {
       read_texcoord(tokens, line_no);
     } else if (keyword == "f") {
       read_face(tokens, line_no);
+    } else if (keyword == "usemtl") {
+      use_material(tokens.rest());
+    } else if (keyword == "mtllib") {
+      read_libraries(tokens, line_no);
+    } else if (keyword == "l") {
+      ++lines_;
+    } else if (keyword == "p") {
+      ++points_;
     }
   }
 
-  /// After the last line: checks the forward references, converts the colours and resolves
-  /// the corner normals.
+  /// After the last line: checks the forward references, converts the colours, splits the
+  /// faces into triangles, resolves the corner normals and applies the materials.
   LoadedMesh finish() {
     if (max_forward_index_ > static_cast<long long>(mesh_->positions.size())) {
       fail(name_, max_forward_line_, out_of_range(max_forward_index_, mesh_->positions.size()));
@@ -219,8 +169,18 @@ class ObjParser {
     }
     LoadedMesh loaded;
     loaded.data = mesh_;
+    loaded.warnings = std::move(warnings_);
+    split_faces(loaded);
     if (any_face_normal_) resolve_corner_normals(normal_refs_, normals_, name_, loaded);
     if (any_face_uv_) resolve_corner_texcoords(uv_refs_, texcoords_, name_, loaded);
+    apply_obj_materials(library_, material_names_, triangle_names_, name_, loaded);
+    for (const std::string& warning : library_.warnings) loaded.warnings.push_back(warning);
+    load_color_maps(*mesh_, loaded);
+    if (lines_ + points_ > 0) {
+      loaded.warnings.push_back(name_ + ": " + std::to_string(lines_) + " line (l) and " +
+                                std::to_string(points_) +
+                                " point (p) statements not drawn: covrast draws faces only");
+    }
     loaded.dropped_nonfinite_triangles = drop_nonfinite_triangles(*mesh_);
     analyze_mesh_topology(*mesh_);  // once per file: instances share the result
     loaded.data = std::move(mesh_);
@@ -228,6 +188,30 @@ class ObjParser {
   }
 
  private:
+  /// map_Kd (sRGB, docs/textures.md): each distinct file decoded once and shared by the
+  /// materials naming it; a missing or undecodable image is an InputError naming it.
+  void load_color_maps(MeshData& mesh, LoadedMesh& loaded) const {
+    std::map<std::string, std::shared_ptr<const Texture>> maps;
+    std::size_t without_uvs = 0;
+    for (Material& m : mesh.materials) {
+      if (m.base_color_texture_path.empty()) continue;
+      std::shared_ptr<const Texture>& texture = maps[m.base_color_texture_path];
+      if (!texture) {
+        // Named relative to the OBJ file, as the .mtl usually gives it (short enough to print).
+        const std::filesystem::path path(m.base_color_texture_path);
+        std::string shown = path.lexically_relative(base_dir_).string();
+        if (shown.empty()) shown = path.filename().string();
+        texture = load_texture_file(path, name_ + ": map_Kd " + printable(shown), true);
+      }
+      m.base_color_texture.texture = texture;
+      without_uvs += any_face_uv_ ? 0 : 1;
+    }
+    if (without_uvs > 0) {
+      loaded.warnings.push_back(name_ + ": " + std::to_string(without_uvs) +
+                                " materials have a map_Kd but the file has no vt: UV (0, 0) used");
+    }
+  }
+
   /// "v x y z", "v x y z w" or "v x y z r g b".
   void read_vertex(Tokens& tokens, std::size_t line_no) {
     double values[6] = {0.0, 0.0, 0.0, 1.0, 1.0, 1.0};
@@ -286,45 +270,98 @@ class ObjParser {
     texcoords_.emplace_back(static_cast<float>(values[0]), static_cast<float>(1.0 - values[1]));
   }
 
-  /// "f" and its corners; the polygon becomes the fan (0, k, k + 1).
+  /// "f" and its corners, kept until finish() (a corner may name a vertex defined later).
   void read_face(Tokens& tokens, std::size_t line_no) {
-    corners_.clear();
-    corner_normals_.clear();
-    corner_uvs_.clear();
+    const std::size_t first = face_vertices_.size();
     std::string_view token;
     while (tokens.next(token)) {
-      if (corners_.size() == kMaxObjFaceCorners) {
+      if (face_vertices_.size() - first == kMaxObjFaceCorners) {
         fail(name_, line_no,
              "face has more than " + std::to_string(kMaxObjFaceCorners) +
                  " corners (docs/limits.md)");
       }
-      corners_.push_back(corner_vertex(token, line_no));
-      corner_normals_.push_back(corner_normal(token, normals_.size(), name_, line_no));
-      corner_uvs_.push_back(corner_texcoord(token, texcoords_.size(), name_, line_no));
+      face_vertices_.push_back(corner_vertex(token, line_no));
+      const long long normal = corner_normal(token, normals_.size(), name_, line_no);
+      face_normals_.push_back(normal);
+      any_face_normal_ = any_face_normal_ || normal != kNoNormal;
+      const long long uv = corner_texcoord(token, texcoords_.size(), name_, line_no);
+      face_uvs_.push_back(uv);
+      any_face_uv_ = any_face_uv_ || uv != kNoNormal;
     }
-    if (corners_.size() < 3) {
-      fail(name_, line_no,
-           "face needs at least 3 vertices, got " + std::to_string(corners_.size()));
+    const std::size_t count = face_vertices_.size() - first;
+    if (count < 3) {
+      fail(name_, line_no, "face needs at least 3 vertices, got " + std::to_string(count));
     }
-    const bool face_normals = std::any_of(corner_normals_.begin(), corner_normals_.end(),
-                                          [](long long n) { return n != kNoNormal; });
-    if (face_normals && !any_face_normal_) {
-      // Faces before the first with normals: none (the face normal).
-      normal_refs_.assign(mesh_->indices.size(), kNoNormal);
-      any_face_normal_ = true;
-    }
-    const bool face_uvs = std::any_of(corner_uvs_.begin(), corner_uvs_.end(),
-                                      [](long long t) { return t != kNoNormal; });
-    if (face_uvs && !any_face_uv_) {
-      uv_refs_.assign(mesh_->indices.size(), kNoNormal);
-      any_face_uv_ = true;
-    }
-    for (std::size_t k = 1; k + 1 < corners_.size(); ++k) {
-      for (const std::size_t c : {std::size_t(0), k, k + 1}) {
-        mesh_->indices.push_back(corners_[c]);
-        if (any_face_normal_) normal_refs_.push_back(corner_normals_[c]);
-        if (any_face_uv_) uv_refs_.push_back(corner_uvs_[c]);
+    face_sizes_.push_back(static_cast<std::uint32_t>(count));
+    face_material_.push_back(current_material_);
+  }
+
+  /// Every face into triangles, in file order: the fan for convex polygons, ear clipping
+  /// for concave ones (obj_polygon.cpp); fallbacks counted in a warning.
+  void split_faces(LoadedMesh& loaded) {
+    std::size_t first = 0, fallbacks = 0;
+    std::vector<glm::dvec3> ring;
+    std::vector<std::uint32_t> corners;
+    for (std::size_t f = 0; f < face_sizes_.size(); ++f) {
+      const std::size_t count = face_sizes_[f];
+      ring.clear();
+      corners.clear();
+      bool finite = true;
+      for (std::size_t c = 0; c < count && count > 3; ++c) {
+        ring.emplace_back(mesh_->positions[face_vertices_[first + c]]);
+        finite = finite && std::isfinite(ring.back().x + ring.back().y + ring.back().z);
       }
+      if (count > 3 && finite) {
+        if (triangulate_polygon(ring, corners) == PolygonSplit::Fallback) ++fallbacks;
+      } else {
+        // Triangles; and polygons with a NaN or infinite corner, dropped later anyway.
+        for (std::uint32_t k = 1; k + 1 < count; ++k) corners.insert(corners.end(), {0, k, k + 1});
+      }
+      for (const std::uint32_t c : corners) {
+        mesh_->indices.push_back(face_vertices_[first + c]);
+        if (any_face_normal_) normal_refs_.push_back(face_normals_[first + c]);
+        if (any_face_uv_) uv_refs_.push_back(face_uvs_[first + c]);
+      }
+      triangle_names_.insert(triangle_names_.end(), corners.size() / 3, face_material_[f]);
+      first += count;
+    }
+    if (fallbacks > 0) {
+      loaded.warnings.push_back(name_ + ": " + std::to_string(fallbacks) +
+                                " polygons are degenerate, self-intersecting or have over " +
+                                std::to_string(kMaxEarClipCorners) +
+                                " corners: split as the fan (0, k, k + 1)");
+    }
+  }
+
+  /// "usemtl name": the faces that follow use it (resolved in finish()).
+  void use_material(std::string_view name) {
+    const auto [it, added] =
+        material_index_.try_emplace(std::string(name), std::uint32_t(material_names_.size()));
+    if (added) material_names_.emplace_back(name);
+    current_material_ = it->second;
+  }
+
+  /// "mtllib a.mtl [b.mtl ...]", relative to the OBJ file. The whole rest of the line is
+  /// tried first as one name (names with spaces). An unreadable library is a warning.
+  void read_libraries(Tokens& tokens, std::size_t line_no) {
+    std::vector<std::string> files{std::string(tokens.rest())};
+    if (files[0].empty()) fail(name_, line_no, "mtllib needs a file name");
+    std::error_code ec;
+    if (!std::filesystem::is_regular_file(base_dir_ / files[0], ec)) {
+      files.clear();
+      std::string_view token;
+      while (tokens.next(token)) files.emplace_back(token);
+    }
+    for (const std::string& file : files) {
+      const std::filesystem::path path = base_dir_ / std::filesystem::path(file);
+      std::string text, error;
+      if (!read_whole_file(path, text, error)) {
+        warnings_.push_back(name_ + ":" + std::to_string(line_no) +
+                            ": cannot open material library '" + printable(file) + "': " + error +
+                            "; its materials are not used");
+        continue;
+      }
+      parse_mtl(text, path.lexically_normal().string(), path.parent_path(), library_);
     }
   }
 
@@ -355,18 +392,31 @@ class ObjParser {
   }
 
   const std::string& name_;
+  const std::filesystem::path& base_dir_;
   std::shared_ptr<MeshData> mesh_;
   std::vector<glm::vec3> colors_srgb_;  ///< one per vertex, white where the file gives none
   bool any_color_ = false;
-  std::vector<std::uint32_t> corners_;     ///< of the current face
-  std::vector<glm::vec3> normals_;         ///< vn lines, in file order
-  std::vector<long long> corner_normals_;  ///< of the current face: see corner_normal()
-  std::vector<long long> normal_refs_;     ///< per triangle corner, as corner_normals_
+  std::vector<glm::vec3> normals_;  ///< vn lines, in file order
+  // The faces as read: their corners' vertices and normals (see corner_normal()), sizes and
+  // materials (indices into material_names_).
+  std::vector<std::uint32_t> face_vertices_;
+  std::vector<long long> face_normals_;
+  std::vector<std::uint32_t> face_sizes_;
+  std::vector<std::uint32_t> face_material_;
+  std::vector<long long> normal_refs_;  ///< per triangle corner, as face_normals_
   bool any_face_normal_ = false;
-  std::vector<glm::vec2> texcoords_;   ///< vt lines, in file order, v flipped
-  std::vector<long long> corner_uvs_;  ///< of the current face: see corner_texcoord()
-  std::vector<long long> uv_refs_;     ///< per triangle corner, as corner_uvs_
+  std::vector<glm::vec2> texcoords_;  ///< vt lines, in file order, v flipped
+  std::vector<long long> face_uvs_;   ///< per face corner: see corner_texcoord()
+  std::vector<long long> uv_refs_;    ///< per triangle corner, as face_uvs_
   bool any_face_uv_ = false;
+  // Materials: the libraries read, the usemtl names in order of first use, each triangle's.
+  MtlLibrary library_;
+  std::vector<std::string> material_names_;
+  std::map<std::string, std::uint32_t> material_index_;
+  std::uint32_t current_material_ = kNoObjMaterial;
+  std::vector<std::uint32_t> triangle_names_;
+  std::size_t lines_ = 0, points_ = 0;  ///< "l" and "p" statements, not drawn
+  std::vector<std::string> warnings_;   ///< found while reading (libraries)
   /// Positive indices may point past the vertices read so far (OBJ does not forbid forward
   /// references); the largest one is checked against the final count at the end.
   long long max_forward_index_ = 0;
@@ -375,9 +425,10 @@ class ObjParser {
 
 }  // namespace
 
-LoadedMesh parse_obj(std::string_view text, const std::string& display_name) {
+LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
+                     const std::filesystem::path& base_dir) {
   check_obj_text(text, display_name);
-  ObjParser parser(display_name);
+  ObjParser parser(display_name, base_dir);
   if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
   std::size_t pos = 0;
   std::size_t line_no = 0;

@@ -78,11 +78,21 @@ void check_camera(const Camera& camera) {
   if (!finite(camera.eye) || !finite(camera.target) || !finite(camera.up)) {
     fail("camera", "eye, target and up must be finite");
   }
-  if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
-    fail("camera.fovy_deg", "must be in (0, 180) degrees, got " + std::to_string(camera.fovy_deg));
-  }
-  if (!(camera.near > 0.0 && std::isfinite(camera.near))) {
-    fail("camera.near", "must be > 0, got " + std::to_string(camera.near));
+  if (camera.orthographic) {
+    if (!(camera.ymag > 0.0 && std::isfinite(camera.ymag))) {
+      fail("camera.ymag", "must be > 0, got " + std::to_string(camera.ymag));
+    }
+    if (!(camera.near >= 0.0 && std::isfinite(camera.near))) {
+      fail("camera.near", "must be >= 0, got " + std::to_string(camera.near));
+    }
+  } else {
+    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
+      fail("camera.fovy_deg",
+           "must be in (0, 180) degrees, got " + std::to_string(camera.fovy_deg));
+    }
+    if (!(camera.near > 0.0 && std::isfinite(camera.near))) {
+      fail("camera.near", "must be > 0, got " + std::to_string(camera.near));
+    }
   }
   if (!(camera.far > camera.near && std::isfinite(camera.far))) {
     fail("camera.far", "must be greater than near, got " + std::to_string(camera.far));

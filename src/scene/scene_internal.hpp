@@ -17,14 +17,25 @@ namespace covrast::detail {
 
 /// A camera of a glTF file (glTF 2.0, 3.10), where the scene's {"gltf": N} camera comes from.
 struct FileCamera {
-  bool orthographic = false;  ///< covrast renders perspective only
-  double yfov_rad = 0.0;      ///< vertical field of view [radians]
-  double znear = 0.0;         ///< [file units]
-  double zfar = 0.0;          ///< [file units]; 0: infinite
+  bool orthographic = false;
+  double yfov_rad = 0.0;  ///< perspective: vertical field of view [radians]
+  double ymag = 0.0;      ///< orthographic: half the view's height [file units]
+  double znear = 0.0;     ///< [file units]
+  double zfar = 0.0;      ///< [file units]; 0: infinite
   /// Placed by a node of the walked scene (the first one in the walk that names it); its
   /// world transform then is `world` (the camera looks down its -z, +y up).
   bool placed = false;
   glm::dmat4 world{1.0};
+};
+
+/// A glTF KHR_lights_punctual light on a node of the walked scene (gltf_lights.cpp): type,
+/// colour, intensity, range and cone angles [degrees] as the file gives them; it sits at the
+/// origin of `world` (the node's world transform) and shines down its -z.
+struct FileLight {
+  Light light;
+  glm::dmat4 world{1.0};
+  int index = 0;  ///< in the file's lights
+  int node = 0;   ///< the node that places it
 };
 
 /// A parsed mesh file plus what MeshData cannot carry.
@@ -42,6 +53,8 @@ struct LoadedMesh {
   std::vector<std::string> lit_warnings;
   /// glTF: the file's cameras, in file order.
   std::vector<FileCamera> cameras;
+  /// glTF: the lights on the walked nodes, in walk order.
+  std::vector<FileLight> lights;
 };
 
 /// Reads a whole regular file of at most `max_bytes`. On failure returns false and sets
@@ -58,9 +71,12 @@ std::string size_text(std::uint64_t bytes);
 /// to the byte of the opening bracket. Returns true when the depth stays within `limit`.
 bool json_depth_within(std::string_view text, int limit, std::size_t& offset);
 
-/// Wavefront OBJ: v (optionally with r g b sRGB colours) and f lines; polygons are split into
-/// the fan (0, k, k + 1). `display_name` prefixes every error message ("name:LINE: ...").
-LoadedMesh parse_obj(std::string_view text, const std::string& display_name);
+/// Wavefront OBJ: v (optionally with r g b sRGB colours), vn, f, mtllib and usemtl lines;
+/// convex polygons become the fan (0, k, k + 1), concave ones are ear-clipped. `display_name`
+/// prefixes every error message ("name:LINE: ..."); material libraries are found in
+/// `base_dir`.
+LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
+                     const std::filesystem::path& base_dir);
 
 /// glTF 2.0, either JSON (.gltf) or binary (.glb, recognised by its magic). External buffers
 /// are resolved against `base_dir`.
@@ -74,6 +90,16 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
 /// once, its Texture shared by the materials that name it.
 std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
                                                  const std::string& name, bool srgb);
+
+/// load_mesh_scene's camera for a file without one (scene_auto.cpp): looking down -z at the
+/// centre of the world box of the scene's meshes from the distance where the box's bounding
+/// sphere fits the view with a 5% margin (docs/scene-format.md).
+Camera framing_camera(const Scene& scene);
+
+/// load_mesh_scene's lights for a file without any: a key and a fill directional light and an
+/// ambient one; `pbr` keeps the pbr intensities, else the directional ones are divided by pi
+/// (lambert and blinn-phong have no 1/pi).
+std::vector<Light> default_light_rig(bool pbr);
 
 /// Removes every triangle that uses a vertex with a non-finite coordinate and sets such
 /// vertices to the origin (nothing references them any more). Returns the number removed.

@@ -7,11 +7,13 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <set>
 #include <string_view>
 #include <utility>
@@ -170,15 +172,14 @@ class SceneReader {
     camera.eye = vec3(required(object, "eye", "camera.eye"), "camera.eye");
     camera.target = vec3(required(object, "target", "camera.target"), "camera.target");
     camera.up = vec3(required(object, "up", "camera.up"), "camera.up");
-    camera.fovy_deg = number(required(object, "fovy_deg", "camera.fovy_deg"), "camera.fovy_deg");
+    projection(object, camera);
     camera.near = number(required(object, "near", "camera.near"), "camera.near");
     camera.far = number(required(object, "far", "camera.far"), "camera.far");
-    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
-      fail(file_, "camera.fovy_deg",
-           "must be in (0, 180) degrees, got " + shown(object["fovy_deg"]));
+    if (!(camera.near > 0.0 || (camera.orthographic && camera.near == 0.0))) {
+      fail(file_, "camera.near",
+           std::string(camera.orthographic ? "must be >= 0" : "must be > 0") + ", got " +
+               shown(object["near"]));
     }
-    if (!(camera.near > 0.0))
-      fail(file_, "camera.near", "must be > 0, got " + shown(object["near"]));
     if (!(camera.far > camera.near)) {
       fail(file_, "camera.far", "must be greater than near, got " + shown(object["far"]));
     }
@@ -201,6 +202,35 @@ class SceneReader {
       fail(file_, "camera.up", "must not be zero or parallel to the view direction");
     }
     return camera;
+  }
+
+  /// "projection": "perspective" (the default) with "fovy_deg", or "orthographic" with "ymag"
+  /// (half the view's height, world units).
+  void projection(const json& object, Camera& camera) const {
+    if (const auto it = object.find("projection"); it != object.end()) {
+      if (*it == "orthographic") {
+        camera.orthographic = true;
+      } else if (*it != "perspective") {
+        fail(file_, "camera.projection",
+             "expected \"perspective\" or \"orthographic\", got " + shown(*it));
+      }
+    }
+    if (camera.orthographic) {
+      if (object.contains("fovy_deg")) {
+        fail(file_, "camera.fovy_deg", "an orthographic camera takes ymag, not fovy_deg");
+      }
+      camera.ymag = number(required(object, "ymag", "camera.ymag"), "camera.ymag");
+      if (!(camera.ymag > 0.0)) {
+        fail(file_, "camera.ymag", "must be > 0, got " + shown(object["ymag"]));
+      }
+      return;
+    }
+    if (object.contains("ymag")) fail(file_, "camera.ymag", "only for an orthographic camera");
+    camera.fovy_deg = number(required(object, "fovy_deg", "camera.fovy_deg"), "camera.fovy_deg");
+    if (!(camera.fovy_deg > 0.0 && camera.fovy_deg < 180.0)) {
+      fail(file_, "camera.fovy_deg",
+           "must be in (0, 180) degrees, got " + shown(object["fovy_deg"]));
+    }
   }
 
   /// Row-major: 4 rows of 4 numbers, or 16 numbers in row order; translation in the last
@@ -319,8 +349,16 @@ class SceneReader {
     }
   }
 
-  std::vector<Light> lights(const json& value) const {
-    if (!value.is_array()) fail(file_, "lights", "expected an array, got " + shown(value));
+  /// "lights": an array of light objects in which the string "gltf" (once) stands for the
+  /// lights of the scene's glTF files, or just "gltf"; `gltf_at` is where those go.
+  std::vector<Light> lights(const json& value, std::optional<std::size_t>& gltf_at) const {
+    if (value == "gltf") {
+      gltf_at = 0;
+      return {};
+    }
+    if (!value.is_array()) {
+      fail(file_, "lights", "expected an array or \"gltf\", got " + shown(value));
+    }
     if (value.size() > kMaxSceneLights) {
       fail(file_, "lights",
            std::to_string(value.size()) + " lights, more than " + std::to_string(kMaxSceneLights) +
@@ -328,7 +366,13 @@ class SceneReader {
     }
     std::vector<Light> result;
     for (std::size_t i = 0; i < value.size(); ++i) {
-      result.push_back(light(value[i], "lights[" + std::to_string(i) + "]"));
+      const std::string key = "lights[" + std::to_string(i) + "]";
+      if (value[i] == "gltf") {
+        if (gltf_at) fail(file_, key, "\"gltf\" given twice");
+        gltf_at = result.size();
+      } else {
+        result.push_back(light(value[i], key));
+      }
     }
     return result;
   }
@@ -558,7 +602,7 @@ class SceneMeshes {
       fail(file_, key, "cannot open '" + ref.relative + "': " + error);
     }
     const std::string display = full.lexically_normal().string();
-    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display)
+    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display, full.parent_path())
                                          : detail::parse_gltf(bytes, display, full.parent_path());
   }
 
@@ -615,6 +659,8 @@ struct FirstGltf {
   const detail::LoadedMesh* loaded = nullptr;  ///< null: no glTF mesh (yet)
   std::string relative;                        ///< the file as the scene names it
   glm::dmat4 model{1.0};                       ///< the entry's model matrix
+  /// Every glTF entry (file and model matrix), where "lights": "gltf" takes lights from.
+  std::vector<std::pair<const detail::LoadedMesh*, glm::dmat4>> all;
 };
 
 /// Entry `key` of "meshes": its mesh (loaded through `cache`), colour, model matrix,
@@ -638,8 +684,9 @@ MeshInstance load_instance(const SceneReader& reader, const std::string& file, c
   instance.materials = instance_materials(reader, entry, key, *loaded.data);
   select_normals(reader, file, entry, key, ref.relative, cached, instance);
   if (ref.format == MeshFormat::Gltf && first_gltf.loaded == nullptr) {
-    first_gltf = {&loaded, ref.relative, instance.model};
+    first_gltf = {&loaded, ref.relative, instance.model, {}};
   }
+  if (ref.format == MeshFormat::Gltf) first_gltf.all.emplace_back(&loaded, instance.model);
   return instance;
 }
 
@@ -660,7 +707,8 @@ double far_beyond_meshes(const Scene& scene, const glm::dvec3& eye, double near)
 
 /// "camera": {"gltf": N}: camera N of the scene's first glTF mesh entry, placed at its node's
 /// world transform times that entry's model matrix; it looks down its -z with +y up (glTF
-/// 2.0, 3.10.1). Only perspective cameras; aspectRatio gives way to the image's size.
+/// 2.0, 3.10.1). Perspective (yfov) or orthographic (ymag); aspectRatio and xmag give way to
+/// the image's size.
 Camera gltf_camera(const std::string& file, const json& object, const FirstGltf& first,
                    const Scene& scene) {
   if (object.size() != 1) fail(file, "camera", "with \"gltf\" give no other camera key");
@@ -677,12 +725,15 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
          which + " does not exist (" + std::to_string(cameras.size()) + " cameras)");
   }
   const detail::FileCamera& source = cameras[static_cast<std::size_t>(index)];
-  if (source.orthographic) {
-    fail(file, "camera.gltf", which + " is orthographic: covrast renders perspective only");
-  }
   if (!source.placed) fail(file, "camera.gltf", which + " is on no node of the file's scene");
-  if (!(source.yfov_rad > 0.0 && source.yfov_rad < std::numbers::pi) || !(source.znear > 0.0) ||
-      !(source.zfar == 0.0 || source.zfar > source.znear)) {
+  if (source.orthographic) {
+    if (!(source.ymag > 0.0 && std::isfinite(source.ymag)) || !(source.znear >= 0.0) ||
+        !(source.zfar > source.znear && std::isfinite(source.zfar))) {
+      fail(file, "camera.gltf",
+           which + " (orthographic) needs ymag > 0, znear >= 0 and zfar > znear");
+    }
+  } else if (!(source.yfov_rad > 0.0 && source.yfov_rad < std::numbers::pi) ||
+             !(source.znear > 0.0) || !(source.zfar == 0.0 || source.zfar > source.znear)) {
     fail(file, "camera.gltf", which + " needs 0 < yfov < pi, znear > 0 and zfar > znear");
   }
   const glm::dmat4 world = first.model * source.world;
@@ -696,7 +747,12 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
     fail(file, "camera.gltf", which + ": its node's transform is degenerate");
   }
   camera.target = camera.eye + forward / length;
-  camera.fovy_deg = glm::degrees(source.yfov_rad);
+  camera.orthographic = source.orthographic;
+  if (source.orthographic) {
+    camera.ymag = source.ymag;
+  } else {
+    camera.fovy_deg = glm::degrees(source.yfov_rad);
+  }
   camera.near = source.znear;
   camera.far = source.zfar > 0.0 ? source.zfar : far_beyond_meshes(scene, camera.eye, camera.near);
   return camera;
@@ -707,10 +763,12 @@ Camera gltf_camera(const std::string& file, const json& object, const FirstGltf&
 /// front end does, overflow at a corner of its box, so that the clipper can only cull it.
 void warn_beyond_finite_range(Scene& scene) {
   const Camera& cam = scene.camera;
-  const glm::dmat4 view_projection =
-      glm::perspective(glm::radians(cam.fovy_deg), double(scene.width) / double(scene.height),
-                       cam.near, cam.far) *
-      glm::lookAt(cam.eye, cam.target, cam.up);
+  const double aspect = double(scene.width) / double(scene.height);
+  const glm::dmat4 projection =
+      cam.orthographic ? glm::ortho(-cam.ymag * aspect, cam.ymag * aspect, -cam.ymag, cam.ymag,
+                                    cam.near, cam.far)
+                       : glm::perspective(glm::radians(cam.fovy_deg), aspect, cam.near, cam.far);
+  const glm::dmat4 view_projection = projection * glm::lookAt(cam.eye, cam.target, cam.up);
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];
     if (instance.mesh->triangle_count() == 0) continue;
@@ -729,6 +787,30 @@ void warn_beyond_finite_range(Scene& scene) {
                                "makes clip-space coordinates overflow): nothing of it is drawn");
     }
   }
+}
+
+/// "lights": "gltf": the KHR_lights_punctual lights of every glTF mesh entry, in entry order
+/// and each file's walk order, placed at the light's node's world transform times the
+/// entry's model matrix; the light shines down the node's -z. Checked as add_light checks.
+std::vector<Light> gltf_lights(const std::string& file, const FirstGltf& gltf) {
+  std::vector<Light> lights;
+  for (const auto& [loaded, model] : gltf.all) {
+    for (const detail::FileLight& source : loaded->lights) {
+      const glm::dmat4 world = model * source.world;
+      Light light = source.light;
+      light.position = glm::dvec3(world[3]);
+      light.direction = glm::dmat3(world) * glm::dvec3(0.0, 0.0, -1.0);
+      const double length = glm::length(light.direction);
+      if (light.type != LightType::Point && (!(length > 0.0) || !std::isfinite(length))) {
+        fail(file, "lights",
+             "light " + std::to_string(source.index) + " of '" + loaded->data->source + "' (node " +
+                 std::to_string(source.node) + "): its transform is degenerate");
+      }
+      if (length > 0.0) light.direction /= length;
+      lights.push_back(light);
+    }
+  }
+  return lights;
 }
 
 /// The scene file's top-level JSON object.
@@ -753,36 +835,24 @@ std::size_t Scene::triangle_count() const {
   return total;
 }
 
-namespace {
-Scene load_scene_files(const std::filesystem::path& json_path,
-                       std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files);
-}  // namespace
-
 Scene load_scene(const std::filesystem::path& json_path) {
   MeshFileCache meshes;
   return load_scene(json_path, meshes);
 }
 
-Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
-  // Every JSON access checks its type first; this is the net under them, so that a missed
-  // check is still an input error naming the file, not an internal error.
-  try {
-    return load_scene_files(json_path, mesh_files.impl_->files);
-  } catch (const json::exception& e) {
-    throw InputError(json_path.string() + ": " + exception_detail(e));
-  }
-}
-
 namespace {
 
-Scene load_scene_files(const std::filesystem::path& json_path,
-                       std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files) {
-  const std::string file = json_path.string();
-  const json root = read_scene_root(json_path, file);
+using MeshFiles = std::map<std::pair<std::string, MeshFormat>, CachedMesh>;
+
+/// load_scene's work on a parsed root: `file` names it in messages, mesh paths are relative to
+/// `base_dir`, meshes come from and go to `files`. `cameras`, if given, receives the first glTF
+/// entry's cameras (load_mesh_scene looks for one there).
+Scene scene_from_root(const json& root, const std::string& file,
+                      const std::filesystem::path& base_dir, MeshFiles& files,
+                      std::vector<detail::FileCamera>* cameras) {
   const SceneReader reader(file);
 
   Scene scene;
-  scene.source = json_path;
   scene.width = reader.image_side(root, "width");
   scene.height = reader.image_side(root, "height");
   if (const auto it = root.find("background"); it != root.end()) {
@@ -791,14 +861,15 @@ Scene load_scene_files(const std::filesystem::path& json_path,
   const json& camera = reader.required(root, "camera", "camera");
   const bool camera_from_gltf = camera.is_object() && camera.contains("gltf");
   if (!camera_from_gltf) scene.camera = reader.camera(root);
+  std::optional<std::size_t> gltf_lights_at;
   if (const auto it = root.find("lights"); it != root.end()) {
     scene.lit = true;
-    scene.lights = reader.lights(*it);
+    scene.lights = reader.lights(*it, gltf_lights_at);
   }
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  SceneMeshes cache(file, json_path.parent_path(), files);
+  SceneMeshes cache(file, base_dir, files);
   FirstGltf first_gltf;
   std::uint64_t triangles = 0;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
@@ -812,10 +883,78 @@ Scene load_scene_files(const std::filesystem::path& json_path,
     }
   }
   if (camera_from_gltf) scene.camera = gltf_camera(file, camera, first_gltf, scene);
-  warn_beyond_finite_range(scene);
+  if (gltf_lights_at) {
+    const std::vector<Light> lights = gltf_lights(file, first_gltf);
+    scene.lights.insert(scene.lights.begin() + std::ptrdiff_t(*gltf_lights_at), lights.begin(),
+                        lights.end());
+  }
+  if (cameras != nullptr && first_gltf.loaded != nullptr) *cameras = first_gltf.loaded->cameras;
   return scene;
 }
 
 }  // namespace
+
+Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
+  // Every JSON access checks its type first; this is the net under them, so that a missed
+  // check is still an input error naming the file, not an internal error.
+  try {
+    const std::string file = json_path.string();
+    const json root = read_scene_root(json_path, file);
+    Scene scene =
+        scene_from_root(root, file, json_path.parent_path(), mesh_files.impl_->files, nullptr);
+    scene.source = json_path;
+    warn_beyond_finite_range(scene);
+    return scene;
+  } catch (const json::exception& e) {
+    throw InputError(json_path.string() + ": " + exception_detail(e));
+  }
+}
+
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height) {
+  const std::string file = mesh_path.string();
+  std::string ext = mesh_path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
+    throw InputError(file + ": unknown mesh format (expected .obj, .gltf or .glb)");
+  }
+  std::string bytes, error;
+  if (!detail::read_whole_file(mesh_path, bytes, error)) {
+    throw InputError(file + ": cannot open: " + error);
+  }
+  const bool gltf = ext != ".obj";
+  // The file as a one-entry scene, through the scene loader and its checks; the camera is a
+  // placeholder until the file's own or the framing one replaces it.
+  json root = {{"width", width},
+               {"height", height},
+               {"background", {0.18, 0.18, 0.2}},
+               {"camera",
+                {{"eye", {0, 0, 1}},
+                 {"target", {0, 0, 0}},
+                 {"up", {0, 1, 0}},
+                 {"fovy_deg", 40},
+                 {"near", 0.1},
+                 {"far", 10}}},
+               {"meshes", json::array({{{gltf ? "gltf" : "obj", mesh_path.filename().string()}}})}};
+  if (gltf) root["lights"] = "gltf";
+  MeshFiles files;  // the second pass below takes the parsed file from here
+  std::vector<detail::FileCamera> cameras;
+  Scene scene = scene_from_root(root, file, mesh_path.parent_path(), files, &cameras);
+  const auto placed = std::find_if(cameras.begin(), cameras.end(),
+                                   [](const detail::FileCamera& c) { return c.placed; });
+  if (placed != cameras.end()) {
+    root["camera"] = {{"gltf", static_cast<std::uint64_t>(placed - cameras.begin())}};
+    scene = scene_from_root(root, file, mesh_path.parent_path(), files, nullptr);
+  } else {
+    scene.camera = detail::framing_camera(scene);
+  }
+  if (scene.lights.empty()) {
+    for (const Light& light : detail::default_light_rig(gltf)) add_light(scene, light);
+  }
+  scene.lit = true;
+  scene.source = mesh_path;
+  warn_beyond_finite_range(scene);
+  return scene;
+}
 
 }  // namespace covrast
