@@ -177,12 +177,95 @@ TEST_CASE("textures: mip chain of odd sizes keeps every texel (3-texel boxes at 
   for (int y = 0; y < 3; ++y) {
     for (int x = 2; x < 5; ++x) expected += (y * 5 + x) * 17 / 255.0 / 9.0;
   }
-  REQUIRE(texture->levels[1].at(1, 0).r == Approx(expected).epsilon(1e-6));
-  // The last level's mean equals the whole image's for even sides.
+  // 136 / 255 exactly: the mean of 17 x (2, 3, 4, 7, 8, 9, 12, 13, 14) is 17 x 8.
+  REQUIRE(texture->levels[1].at(1, 0)[0] == 136);
+  REQUIRE(texture->linear(1, 1, 0).r == Approx(expected).epsilon(1e-12));
+  // The last level is the whole image's mean for even sides, to the nearest code.
   const auto even = covrast::make_texture("even", 8, 4, random_rgba(8, 4, 3), false);
   double mean = 0.0;
-  for (const glm::vec4& t : even->levels[0].texels) mean += t.g / 32.0;
-  REQUIRE(even->levels.back().texels[0].g == Approx(mean).epsilon(1e-6));
+  for (int y = 0; y < 4; ++y) {
+    for (int x = 0; x < 8; ++x) mean += even->linear(0, x, y).g / 32.0;
+  }
+  REQUIRE(std::abs(even->linear(int(even->levels.size()) - 1, 0, 0).g - mean) <= 0.5 / 255.0);
+  // Level 0 keeps every byte through the 8 x 8 block layout, sides not multiples of 8 too.
+  const auto rows = random_rgba(13, 11, 9);
+  const auto blocked = covrast::make_texture("blocked", 13, 11, rows, true);
+  REQUIRE(blocked->levels[0].rgba8.size() == 2 * 2 * 64 * 4);
+  int moved = 0;
+  for (int y = 0; y < 11; ++y) {
+    for (int x = 0; x < 13; ++x) {
+      for (int c = 0; c < 4; ++c)
+        moved += blocked->levels[0].at(x, y)[c] != rows[(y * 13 + x) * 4 + c];
+    }
+  }
+  REQUIRE(moved == 0);
+  REQUIRE(blocked->linear(0, 12, 10).r ==
+          Approx(srgb_decode(rows[(10 * 13 + 12) * 4])).epsilon(1e-12));
+  // A code-built level whose storage does not match its size is refused, not read.
+  auto broken = std::make_shared<covrast::Texture>(*blocked);
+  broken->levels[1].rgba8.resize(16);
+  covrast::Material material;
+  material.base_color_texture.texture = broken;
+  covrast::Scene scene = quad_scene(8, covrast::TextureSlot{});
+  REQUIRE_THROWS_WITH(covrast::add_instance(scene, scene.meshes[0].mesh, {.material = material}),
+                      Contains("do not match its size"));
+}
+
+TEST_CASE("textures: each stored mip code is the nearest to the exact linear-light box mean",
+          "[textures]") {
+  // Reference: the chain in double from level 0's decoded codes, each level from the
+  // unrounded level above (make_texture's definition); a stored code may differ from
+  // 255 encode(exact mean) by at most half a code. Filtering from the rounded 8-bit level
+  // above instead accumulates rounding and fails this on the deeper levels.
+  for (const bool srgb : {true, false}) {
+    INFO("srgb " << srgb);
+    const int width = 37, height = 23;
+    const auto rgba = random_rgba(width, height, 17);
+    const auto texture = covrast::make_texture("odd", width, height, rgba, srgb);
+    const auto decode = [&](int code, int c) {
+      return srgb && c < 3 ? srgb_decode(code) : code / 255.0;
+    };
+    const auto encode_255 = [&](double linear, int c) {
+      return srgb && c < 3 ? srgb_encode_255(linear) : 255.0 * linear;
+    };
+    int w = width, h = height;
+    std::vector<double> above(std::size_t(w) * h * 4);
+    for (std::size_t i = 0; i < above.size(); ++i) above[i] = decode(rgba[i], int(i % 4));
+    double worst = 0.0;
+    int checked = 0;
+    for (std::size_t level = 1; level < texture->levels.size(); ++level) {
+      const int nw = std::max(1, w / 2), nh = std::max(1, h / 2);
+      REQUIRE(texture->levels[level].width == nw);
+      REQUIRE(texture->levels[level].height == nh);
+      // Per axis: texels 2i, 2i + 1, and 2i + 2 for the last texel of an odd side.
+      const auto span = [](int i, int n, int m) {
+        return n == 1 ? std::pair(0, 1) : std::pair(2 * i, (n % 2 == 1 && i == m - 1) ? 3 : 2);
+      };
+      std::vector<double> next(std::size_t(nw) * nh * 4);
+      for (int j = 0; j < nh; ++j) {
+        for (int i = 0; i < nw; ++i) {
+          const auto [x0, nx] = span(i, w, nw);
+          const auto [y0, ny] = span(j, h, nh);
+          for (int c = 0; c < 4; ++c) {
+            double sum = 0.0;
+            for (int y = y0; y < y0 + ny; ++y) {
+              for (int x = x0; x < x0 + nx; ++x) sum += above[(std::size_t(y) * w + x) * 4 + c];
+            }
+            const double mean = sum / (nx * ny);
+            next[(std::size_t(j) * nw + i) * 4 + c] = mean;
+            const int code = texture->levels[level].at(i, j)[c];
+            worst = std::max(worst, std::abs(code - encode_255(mean, c)));
+            ++checked;
+          }
+        }
+      }
+      above = std::move(next);
+      w = nw;
+      h = nh;
+    }
+    REQUIRE(checked > 1000);
+    REQUIRE(worst <= 0.5 + 1e-9);
+  }
 }
 
 TEST_CASE("textures: wrap modes and KHR_texture_transform against an analytic texel lookup",
@@ -317,12 +400,13 @@ TEST_CASE("textures: the level of detail on a tilted plane follows the derivativ
           "[textures]") {
   // 256x256 with nine levels, each one solid colour of its own (red = 20 x level + 10).
   auto texture = std::make_shared<covrast::Texture>();
+  texture->srgb = true;
   for (int level = 0, side = 256; side >= 1; ++level, side /= 2) {
-    covrast::TextureLevel l;
-    l.width = l.height = side;
-    const float red = float(srgb_decode(20 * level + 10));
-    l.texels.assign(std::size_t(side) * side, glm::vec4(red, 0.0f, 0.0f, 1.0f));
-    texture->levels.push_back(std::move(l));
+    std::vector<std::uint8_t> rows;
+    for (int t = 0; t < side * side; ++t) {
+      rows.insert(rows.end(), {std::uint8_t(20 * level + 10), 0, 0, 255});
+    }
+    texture->levels.push_back(covrast::TextureLevel::from_rows(side, side, rows));
   }
   covrast::TextureSlot slot;
   slot.texture = texture;
@@ -504,7 +588,7 @@ TEST_CASE("textures: PNG and JPEG decoded by content, from files, data URIs and 
   const auto c = covrast::load_mesh(dir / "c.glb");
   const covrast::TextureSlot& e = c->materials[0].emissive_texture;
   REQUIRE(e.texture->levels[0].width == 4);
-  REQUIRE(e.texture->levels[0].texels[0].r == Approx(srgb_decode(128)).epsilon(1e-6));
+  REQUIRE(e.texture->linear(0, 0, 0).r == Approx(srgb_decode(128)).epsilon(1e-12));
   REQUIRE(e.sampler.mag == covrast::TextureFilter::Nearest);
   REQUIRE(e.sampler.min == covrast::TextureFilter::Nearest);
   REQUIRE(e.sampler.mip == covrast::MipFilter::Linear);
@@ -542,7 +626,7 @@ TEST_CASE("textures: KHR_texture_transform and texCoord are read per slot", "[te
   // One image, two colour spaces: sRGB for base colour, linear for the others.
   REQUIRE(m.base_color_texture.texture != m.metallic_roughness_texture.texture);
   REQUIRE(m.metallic_roughness_texture.texture == m.occlusion_texture.texture);
-  REQUIRE(m.metallic_roughness_texture.texture->levels[0].texels[0].r == Approx(200 / 255.0));
+  REQUIRE(m.metallic_roughness_texture.texture->linear(0, 0, 0).r == Approx(200 / 255.0));
 }
 
 TEST_CASE("textures: bad images are InputErrors naming the image and the model", "[textures]") {
@@ -704,7 +788,7 @@ TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") 
   const auto texture =
       covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true);
   REQUIRE(texture->levels[0].width == 3);
-  REQUIRE(texture->levels[0].texels[0].g == Approx(srgb_decode(64)).epsilon(1e-6));
+  REQUIRE(texture->linear(0, 0, 0).g == Approx(srgb_decode(64)).epsilon(1e-12));
   REQUIRE_THROWS_WITH(
       covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
       Contains("m.obj: map_Kd no.png: cannot read image"));

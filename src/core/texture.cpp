@@ -1,6 +1,7 @@
-// Textures (docs/textures.md): building the linear-light mip chain once at scene load
-// (make_texture) and sampling it (texture_sampling.hpp). Double precision throughout, no
-// contraction: the same bits in every mode, tile, thread and compiler.
+// Textures (docs/textures.md): building the 8-bit mip chain, filtered in linear light, once at
+// scene load (make_texture) and sampling it (texture_sampling.hpp), each texel decoded to
+// linear light by a 256-entry table. Double precision throughout, no contraction: the same
+// bits in every mode, tile, thread and compiler.
 #include "core/texture_sampling.hpp"
 
 #include <covrast/error.hpp>
@@ -13,16 +14,57 @@
 namespace covrast {
 namespace {
 
-/// IEC 61966-2-1 decoding of the 256 8-bit codes: c <= 0.04045 ? c / 12.92 :
-/// ((c + 0.055) / 1.055)^2.4, c = code / 255.
-std::array<float, 256> srgb_decode_table() {
-  std::array<float, 256> table{};
-  for (int code = 0; code < 256; ++code) {
-    const double c = code / 255.0;
-    table[std::size_t(code)] = float(c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4));
-  }
-  return table;
+/// IEC 61966-2-1 decoding of an encoded value c in [0, 1]:
+/// c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055)^2.4.
+double srgb_to_linear(double c) {
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
 }
+
+/// One encoding of a stored channel: code / 255 (linear slots, and alpha always) or sRGB (the
+/// RGB of sRGB slots). `linear` holds the 256 codes in linear light (sampling); `threshold`
+/// the 255 linear values where the nearest code changes, threshold[k] = decode((k + 0.5) /
+/// 255), with threshold[255] = +inf as a sentinel (building the mips: a value's code is the
+/// number of thresholds at or below it, i.e. round(255 encode(value)) in the encoded domain,
+/// halves up). `start[i]` is the code of i / kBuckets, where the threshold steps begin.
+struct ChannelCode {
+  static constexpr int kBuckets = 4096;  // under one sRGB code per bucket (slope 12.92 x 255)
+  std::array<double, 256> linear{};
+  std::array<double, 256> threshold{};
+  std::array<std::uint8_t, kBuckets + 1> start{};
+  template <class Decode>
+  explicit ChannelCode(const Decode& decode) {
+    for (int code = 0; code < 256; ++code) linear[std::size_t(code)] = decode(code / 255.0);
+    for (int k = 0; k < 255; ++k) threshold[std::size_t(k)] = decode((k + 0.5) / 255.0);
+    threshold[255] = std::numeric_limits<double>::infinity();
+    for (int i = 0, code = 0; i <= kBuckets; ++i) {
+      while (threshold[std::size_t(code)] <= double(i) / kBuckets) ++code;
+      start[std::size_t(i)] = std::uint8_t(code);
+    }
+  }
+  /// The nearest code of a linear value: a bucket look-up, then a step or two (no search).
+  std::uint8_t encode(double value) const {
+    if (!(value > 0.0)) return 0;
+    if (value >= 1.0) return 255;
+    // i / kBuckets <= value for i = floor(value kBuckets): exact power-of-2 scaling.
+    int code = start[std::size_t(value * kBuckets)];
+    while (threshold[std::size_t(code)] <= value) ++code;
+    return std::uint8_t(code);
+  }
+};
+
+/// Built once at start-up (no guard on every texel fetch, as a function-local static would
+/// need); nothing builds or samples a texture during static initialisation.
+const ChannelCode g_unit([](double c) { return c; });
+const ChannelCode g_srgb(srgb_to_linear);
+
+/// Decodes stored texels: RGB through the texture's encoding, alpha as code / 255.
+struct TexelDecoder {
+  const double* rgb;
+  explicit TexelDecoder(bool srgb) : rgb(srgb ? g_srgb.linear.data() : g_unit.linear.data()) {}
+  glm::dvec4 operator()(const std::uint8_t* p) const {
+    return glm::dvec4(rgb[p[0]], rgb[p[1]], rgb[p[2]], g_unit.linear[p[3]]);
+  }
+};
 
 /// The source texels that texel `i` of the next level averages along one side of `n`
 /// texels (next side m = max(1, floor(n / 2))): 2i and 2i + 1, and 2i + 2 for the last texel
@@ -37,22 +79,53 @@ Footprint footprint(int i, int n) {
   return {2 * i, (n % 2 == 1 && i == m - 1) ? 3 : 2};
 }
 
-/// Level k + 1 of a chain: the box filter of `source` (the mean over each footprint).
-TextureLevel downsample(const TextureLevel& source) {
-  TextureLevel level;
-  level.width = std::max(1, source.width / 2);
-  level.height = std::max(1, source.height / 2);
+/// A mip level in linear light before rounding, 4 doubles a texel: the next level is filtered
+/// from these exact means, not from the rounded codes, and they are dropped once it is built.
+struct LinearLevel {
+  int width = 0;
+  int height = 0;
+  std::vector<glm::dvec4> texels;
+};
+
+/// The box filter of a width x height source whose texel (x, y) is `fetch(x, y)` in linear
+/// light: the mean over each footprint, summed in double.
+template <class Fetch>
+LinearLevel box_filter(int width, int height, const Fetch& fetch) {
+  LinearLevel level;
+  level.width = std::max(1, width / 2);
+  level.height = std::max(1, height / 2);
   level.texels.resize(std::size_t(level.width) * std::size_t(level.height));
   for (int j = 0; j < level.height; ++j) {
-    const Footprint fy = footprint(j, source.height);
+    const Footprint fy = footprint(j, height);
     for (int i = 0; i < level.width; ++i) {
-      const Footprint fx = footprint(i, source.width);
+      const Footprint fx = footprint(i, width);
       glm::dvec4 sum(0.0);
       for (int y = fy.first; y < fy.first + fy.count; ++y) {
-        for (int x = fx.first; x < fx.first + fx.count; ++x) sum += glm::dvec4(source.at(x, y));
+        for (int x = fx.first; x < fx.first + fx.count; ++x) sum += fetch(x, y);
       }
+      // A 2x2 box: x 0.25 is the same IEEE result as / 4 (a power of two), and cheaper.
+      const int count = fx.count * fy.count;
       level.texels[std::size_t(j) * std::size_t(level.width) + std::size_t(i)] =
-          glm::vec4(sum / double(fx.count * fy.count));
+          count == 4 ? sum * 0.25 : sum / double(count);
+    }
+  }
+  return level;
+}
+
+/// A linear level stored: each channel as its nearest code (RGB in sRGB when `srgb`).
+TextureLevel encode_level(const LinearLevel& source, bool srgb) {
+  const ChannelCode& rgb = srgb ? g_srgb : g_unit;
+  TextureLevel level;
+  level.width = source.width;
+  level.height = source.height;
+  level.rgba8.assign(TextureLevel::bytes(level.width, level.height), 0);
+  for (int y = 0; y < level.height; ++y) {
+    for (int x = 0; x < level.width; ++x) {
+      const glm::dvec4& v =
+          source.texels[std::size_t(y) * std::size_t(level.width) + std::size_t(x)];
+      std::uint8_t* out = level.at(x, y);
+      for (int c = 0; c < 3; ++c) out[c] = rgb.encode(v[c]);
+      out[3] = g_unit.encode(v.a);
     }
   }
   return level;
@@ -60,26 +133,48 @@ TextureLevel downsample(const TextureLevel& source) {
 
 }  // namespace
 
+TextureLevel TextureLevel::from_rows(int width, int height, const std::vector<std::uint8_t>& rows) {
+  TextureLevel level;
+  level.width = width;
+  level.height = height;
+  level.rgba8.assign(bytes(width, height), 0);
+  // Row by row, one block's run of up to 8 texels at a time (contiguous in both layouts).
+  for (int y = 0; y < height; ++y) {
+    const std::uint8_t* row = &rows[std::size_t(y) * std::size_t(width) * 4];
+    for (int x = 0; x < width; x += kBlockSide) {
+      const int run = std::min(kBlockSide, width - x);
+      std::copy(row + std::size_t(x) * 4, row + std::size_t(x + run) * 4, level.at(x, y));
+    }
+  }
+  return level;
+}
+
+glm::dvec4 Texture::linear(int level, int x, int y) const {
+  return TexelDecoder(srgb)(levels[std::size_t(level)].at(x, y));
+}
+
 std::shared_ptr<const Texture> make_texture(std::string name, int width, int height,
-                                            const std::vector<std::uint8_t>& rgba8, bool srgb) {
+                                            std::vector<std::uint8_t> rgba8, bool srgb) {
   if (width <= 0 || height <= 0 || rgba8.size() != std::size_t(width) * std::size_t(height) * 4) {
     throw InputError(name + ": texture size does not match its texels");
   }
-  static const std::array<float, 256> kSrgb = srgb_decode_table();
   auto texture = std::make_shared<Texture>();
   texture->name = std::move(name);
-  TextureLevel base;
-  base.width = width;
-  base.height = height;
-  base.texels.resize(std::size_t(width) * std::size_t(height));
-  for (std::size_t t = 0; t < base.texels.size(); ++t) {
-    const std::uint8_t* p = &rgba8[4 * t];
-    const auto channel = [&](int c) { return srgb ? kSrgb[p[c]] : float(p[c] / 255.0); };
-    base.texels[t] = glm::vec4(channel(0), channel(1), channel(2), float(p[3] / 255.0));
-  }
-  texture->levels.push_back(std::move(base));
-  while (texture->levels.back().width > 1 || texture->levels.back().height > 1) {
-    texture->levels.push_back(downsample(texture->levels.back()));
+  texture->srgb = srgb;
+  texture->levels.push_back(TextureLevel::from_rows(width, height, rgba8));
+  std::vector<std::uint8_t>().swap(rgba8);  // the decoded rows are no longer needed
+  if (width == 1 && height == 1) return texture;
+  const TexelDecoder decode(srgb);
+  const TextureLevel& base = texture->levels[0];
+  LinearLevel above =
+      box_filter(width, height, [&](int x, int y) { return decode(base.at(x, y)); });
+  for (;;) {
+    texture->levels.push_back(encode_level(above, srgb));
+    if (above.width == 1 && above.height == 1) break;
+    const std::size_t stride = std::size_t(above.width);
+    above = box_filter(above.width, above.height, [&](int x, int y) {
+      return above.texels[std::size_t(y) * stride + std::size_t(x)];
+    });
   }
   return texture;
 }
@@ -98,6 +193,10 @@ int wrap_texel(long long i, int size, TextureWrap wrap) {
     }
     case TextureWrap::Repeat:
     default:
+      // One period off (a bilinear neighbour across the seam, UVs just past 0 or 1): the
+      // same remainder without a 64-bit division.
+      if (i >= -size && i < 0) return int(i + size);
+      if (i >= size && i < 2LL * size) return int(i - size);
       return int(((i % size) + size) % size);
   }
 }
@@ -123,12 +222,14 @@ long long texel_floor(double v) {
   return static_cast<long long>(std::floor(v));
 }
 
-glm::dvec4 sample_level(const TextureLevel& level, const TextureSampler& sampler,
-                        const glm::dvec2& uv, TextureFilter filter) {
+/// One level filtered at `uv`, each fetched texel decoded to linear light (`decode`) before it
+/// is weighted: the filter works in linear light.
+glm::dvec4 sample_level(const TextureLevel& level, const TexelDecoder& decode,
+                        const TextureSampler& sampler, const glm::dvec2& uv, TextureFilter filter) {
   const double x = uv.x * level.width, y = uv.y * level.height;
   if (filter == TextureFilter::Nearest) {
-    return glm::dvec4(level.at(wrap_texel(texel_floor(x), level.width, sampler.wrap_s),
-                               wrap_texel(texel_floor(y), level.height, sampler.wrap_t)));
+    return decode(level.at(wrap_texel(texel_floor(x), level.width, sampler.wrap_s),
+                           wrap_texel(texel_floor(y), level.height, sampler.wrap_t)));
   }
   // Bilinear around (x - 0.5, y - 0.5): texel centres are at half-integers.
   const long long x0 = texel_floor(x - 0.5), y0 = texel_floor(y - 0.5);
@@ -137,10 +238,8 @@ glm::dvec4 sample_level(const TextureLevel& level, const TextureSampler& sampler
   const int xb = wrap_texel(x0 + 1, level.width, sampler.wrap_s);
   const int ya = wrap_texel(y0, level.height, sampler.wrap_t);
   const int yb = wrap_texel(y0 + 1, level.height, sampler.wrap_t);
-  const glm::dvec4 top =
-      glm::dvec4(level.at(xa, ya)) * (1.0 - fx) + glm::dvec4(level.at(xb, ya)) * fx;
-  const glm::dvec4 bottom =
-      glm::dvec4(level.at(xa, yb)) * (1.0 - fx) + glm::dvec4(level.at(xb, yb)) * fx;
+  const glm::dvec4 top = decode(level.at(xa, ya)) * (1.0 - fx) + decode(level.at(xb, ya)) * fx;
+  const glm::dvec4 bottom = decode(level.at(xa, yb)) * (1.0 - fx) + decode(level.at(xb, yb)) * fx;
   return top * (1.0 - fy) + bottom * fy;
 }
 
@@ -149,22 +248,26 @@ glm::dvec4 sample_level(const TextureLevel& level, const TextureSampler& sampler
 glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
                           const glm::dvec2& uv, double lod) {
   if (texture.levels.empty()) return glm::dvec4(1.0);  // refused by check_scene; no crash
+  const TexelDecoder decode(texture.srgb);
   const int last = int(texture.levels.size()) - 1;
   if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) {
     const TextureFilter filter = lod > 0.0 ? sampler.min : sampler.mag;
-    return sample_level(texture.levels[0], sampler, uv, filter);
+    return sample_level(texture.levels[0], decode, sampler, uv, filter);
   }
   if (sampler.mip == MipFilter::Nearest) {
     // OpenGL 4.6, 8.14.3: level ceil(lod + 1/2) - 1, clamped to the chain.
     const double chosen = std::ceil(lod + 0.5) - 1.0;
     const int level = chosen >= last ? last : int(chosen);
-    return sample_level(texture.levels[std::size_t(level)], sampler, uv, sampler.min);
+    return sample_level(texture.levels[std::size_t(level)], decode, sampler, uv, sampler.min);
   }
-  if (lod >= last) return sample_level(texture.levels[std::size_t(last)], sampler, uv, sampler.min);
+  if (lod >= last)
+    return sample_level(texture.levels[std::size_t(last)], decode, sampler, uv, sampler.min);
   const int d1 = int(std::floor(lod));
   const double weight = lod - d1;
-  const glm::dvec4 a = sample_level(texture.levels[std::size_t(d1)], sampler, uv, sampler.min);
-  const glm::dvec4 b = sample_level(texture.levels[std::size_t(d1 + 1)], sampler, uv, sampler.min);
+  const glm::dvec4 a =
+      sample_level(texture.levels[std::size_t(d1)], decode, sampler, uv, sampler.min);
+  const glm::dvec4 b =
+      sample_level(texture.levels[std::size_t(d1 + 1)], decode, sampler, uv, sampler.min);
   return a * (1.0 - weight) + b * weight;
 }
 

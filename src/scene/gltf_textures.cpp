@@ -95,8 +95,8 @@ glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fa
 
 std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
                                                  const std::string& name, bool srgb) {
-  const RgbaImage image = read_image(path, name);
-  return make_texture(name, image.width, image.height, image.rgba, srgb);
+  RgbaImage image = read_image(path, name);
+  return make_texture(name, image.width, image.height, std::move(image.rgba), srgb);
 }
 
 RgbaImage GltfTextures::decode(const tinygltf::Image& image, const std::string& image_name) const {
@@ -125,8 +125,9 @@ std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool
   } else if (!image.name.empty()) {
     image_name += " (" + printable(image.name) + ")";
   }
-  const RgbaImage rgba = decode(image, image_name);
-  auto texture = make_texture(image_name, rgba.width, rgba.height, rgba.rgba, srgb);
+  // The decoded bytes become level 0 (moved, not copied): nothing else keeps them.
+  RgbaImage rgba = decode(image, image_name);
+  auto texture = make_texture(image_name, rgba.width, rgba.height, std::move(rgba.rgba), srgb);
   textures_.emplace(key, texture);
   return texture;
 }

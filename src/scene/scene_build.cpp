@@ -40,6 +40,18 @@ bool non_negative(const glm::vec3& v) {
   return finite(v) && v.x >= 0.0f && v.y >= 0.0f && v.z >= 0.0f;
 }
 
+/// Every level of a code-built texture holds the storage its size needs (TextureLevel::bytes;
+/// sampling reads it unchecked).
+bool levels_consistent(const Texture& texture) {
+  for (const TextureLevel& level : texture.levels) {
+    if (level.width <= 0 || level.height <= 0 ||
+        level.rgba8.size() != TextureLevel::bytes(level.width, level.height)) {
+      return false;
+    }
+  }
+  return true;
+}
+
 /// The ranges a scene file's "material" keys accept (docs/scene-format.md).
 void check_material(const Material& m, const std::string& what) {
   if (!(m.metallic >= 0.0f && m.metallic <= 1.0f)) fail(what, "metallic must be in 0..1");
@@ -55,6 +67,9 @@ void check_material(const Material& m, const std::string& what) {
       fail(what, "a texture's texcoord must be 0 or 1");
     }
     if (slot->texture && slot->texture->levels.empty()) fail(what, "a texture has no texels");
+    if (slot->texture && !levels_consistent(*slot->texture)) {
+      fail(what, "a texture level's texels do not match its size (TextureLevel::bytes)");
+    }
     if (!std::isfinite(slot->scale)) fail(what, "a texture's scale must be finite");
   }
   if (!(m.alpha_cutoff >= 0.0 && m.alpha_cutoff <= 1.0)) fail(what, "alpha_cutoff must be in 0..1");
