@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs the Debian packages covrast needs to build and test (Debian 12); with --build-only,
-# just what building the executable needs (no clang). Idempotent: asks
+# just what building the executable needs (no clang); with --aarch64, what cross-building for
+# 64-bit ARM and running it under emulation needs (scripts/check-aarch64.sh): the arm64
+# architecture is added to dpkg first if it is missing. Idempotent: asks
 # dpkg-query which packages are missing and installs only those; when none is missing it does
 # not call apt-get at all. Runs as root (the CI case) or through sudo when available.
 set -euo pipefail
@@ -14,13 +16,26 @@ build_packages=(
 )
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for
 # the scene and report scripts, chromium to load covrast test's HTML report headless.
-test_packages=(clang python3 chromium)
+# libclang-rt-14-dev holds libFuzzer and the sanitizer runtimes (the fuzz, asan, ubsan and
+# tsan presets).
+test_packages=(clang libclang-rt-14-dev python3 chromium)
+# Cross-building for aarch64: the cross compiler, the emulator, `file` (the script checks the
+# executable's architecture) and the arm64 builds of every library with compiled code or an
+# architecture-specific package (the header-only glm, nlohmann-json and CLI11 are
+# architecture-independent and come with the build packages).
+aarch64_packages=(
+  g++-aarch64-linux-gnu qemu-user-static file
+  libtbb-dev:arm64 libhwy-dev:arm64 libspng-dev:arm64 libstb-dev:arm64 libdraco-dev:arm64
+  libtinyobjloader-dev:arm64 libtinygltf-dev:arm64
+)
 
-# Usage: scripts/setup.sh [--build-only]
+# Usage: scripts/setup.sh [--build-only | --aarch64]
 packages=("${build_packages[@]}")
-if [[ "${1:-}" != --build-only ]]; then
-  packages+=("${test_packages[@]}")
-fi
+case "${1:-}" in
+  --build-only) ;;
+  --aarch64) packages+=("${aarch64_packages[@]}") ;;
+  *) packages+=("${test_packages[@]}") ;;
+esac
 
 missing=()
 for package in "${packages[@]}"; do
@@ -46,6 +61,10 @@ else
 fi
 
 echo "setup: installing ${missing[*]}"
+if [[ "${1:-}" == --aarch64 ]] && ! dpkg --print-foreign-architectures | grep -qx arm64; then
+  echo "setup: adding the arm64 architecture to dpkg"
+  "${as_root[@]}" dpkg --add-architecture arm64
+fi
 "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive apt-get update
 "${as_root[@]}" env DEBIAN_FRONTEND=noninteractive \
   apt-get install -y --no-install-recommends "${missing[@]}"

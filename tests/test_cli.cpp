@@ -2,6 +2,7 @@
 // one-line error messages, and that failed runs create no output and leave existing files
 // untouched. Each test writes its scenes, meshes and images into a fresh temporary directory.
 #include <covrast/image.hpp>
+#include <covrast/renderer.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
@@ -254,6 +255,8 @@ TEST_CASE("cli: render of a good scene writes a PNG of the requested size", "[cl
   CHECK(stats.at("tile") == 16);
   CHECK(stats.at("threads") == 2);
   CHECK(stats.at("frames") == 3);
+  // The SIMD target the kernels ran on: the library's own answer (what golden reports record).
+  CHECK(stats.at("simd") == covrast::build_info().simd_target);
   CHECK(stats.at("triangles").at("in") == 1);
   for (const char* key :
        {"setup_ms", "binning_ms", "raster_ms", "resolve_ms", "post_ms", "render_ms"}) {

@@ -1025,7 +1025,7 @@ Scene default_like_scene() {
 }  // namespace
 
 TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD target",
-          "[coverage]") {
+          "[coverage][threads]") {
   const Scene s = default_like_scene();
   const std::vector<std::int64_t> targets = covrast::test::usable_targets();
   const Image baseline = render(s, ModeKind::Coverage, 1, 64).color;

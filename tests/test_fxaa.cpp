@@ -304,7 +304,7 @@ RenderResult render_mode(const Scene& scene, const char* mode, int threads, int 
 }  // namespace
 
 TEST_CASE("fxaa mode: the aliased frame through FXAA, the same bytes for every split",
-          "[fxaa][pipeline]") {
+          "[fxaa][pipeline][threads]") {
   const Scene scene = random_triangles_scene();
   const Image aliased = render_mode(scene, "aliased", 1, 64).color;
   const Image expected = detail::fxaa(aliased, FxaaOptions{});

@@ -17,7 +17,7 @@
 #include "test_meshes.hpp"
 
 TEST_CASE("for_each_in_parallel runs every index once, on at most the threads asked for",
-          "[pipeline][parallel]") {
+          "[pipeline][parallel][threads]") {
   std::vector<std::atomic<int>> runs(1000);
   std::mutex mutex;
   std::set<std::thread::id> workers;
@@ -32,7 +32,7 @@ TEST_CASE("for_each_in_parallel runs every index once, on at most the threads as
 }
 
 TEST_CASE("for_each_in_parallel: frames rendered inside it, and exceptions",
-          "[pipeline][parallel]") {
+          "[pipeline][parallel][threads]") {
   covrast::Scene scene = covrast::test::pixel_scene(48, 32);
   scene.meshes.push_back({});
   scene.meshes.back().mesh = covrast::test::uv_sphere(12, 24);

@@ -963,7 +963,7 @@ TEST_CASE("aliased: at equal depth the earlier triangle wins", "[pipeline]") {
 // 4. Determinism over threads and tiles
 // ---------------------------------------------------------------------------------------
 
-TEST_CASE("images are byte-identical for every thread count and tile size", "[pipeline]") {
+TEST_CASE("images are byte-identical for every thread count and tile size", "[pipeline][threads]") {
   const int w = 333, h = 207;  // not a multiple of any tile size
   Scene scene = pixel_scene(w, h);
   std::mt19937 rng(31337);

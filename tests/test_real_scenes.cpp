@@ -162,39 +162,49 @@ TEST_CASE("covrast-scenegen --real writes the set, the same bytes every run", "[
   CHECK(fs::is_empty(refused.path()));
 }
 
-TEST_CASE("real-content folded_sphere: coverage closer to the reference than ssaa:16", "[real]") {
+// The quality tests below are [sanitizer-slow]: each renders the reference (4,096 samples per
+// pixel) and ssaa:16 of a real-content scene: 1.5-3.5 minutes each under ASan+UBSan (-O1); the
+// same render paths run there in the pipeline, coverage and supersampling tests.
+TEST_CASE("real-content folded_sphere: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("folded_sphere", 160, 90);
 }
 
-TEST_CASE("real-content pleated_sheet: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content pleated_sheet: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("pleated_sheet", 160, 90);
 }
 
-TEST_CASE("real-content torus_knot: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content torus_knot: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("torus_knot", 160, 90);
 }
 
 TEST_CASE("real-content interpenetrating: coverage closer to the reference than ssaa:16",
-          "[real]") {
+          "[real][sanitizer-slow]") {
   check_real_scene("interpenetrating", 160, 90);
 }
 
-TEST_CASE("real-content open_parts: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content open_parts: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("open_parts", 160, 90);
 }
 
-TEST_CASE("real-content decals: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content decals: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("decals", 160, 90);
 }
 
 // 128x72: at 160x90 the reference alone takes about 12 s here (long thin triangles).
-TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content cad_assembly: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("cad_assembly", 128, 72);
 }
 
 // 2,000 copies in every covered pixel make the reference cost 2,000 x 4,096 samples per pixel,
 // so the stacked scenes render at half their 64x48.
-TEST_CASE("real-content stacked: coverage closer to the reference than ssaa:16", "[real]") {
+TEST_CASE("real-content stacked: coverage closer to the reference than ssaa:16",
+          "[real][sanitizer-slow]") {
   check_real_scene("stacked", 32, 24);
 }
 
@@ -204,7 +214,7 @@ TEST_CASE("real-content stacked: coverage closer to the reference than ssaa:16",
 // [!shouldfail] runs it every time and fails the day coverage meets the bound, so that the
 // tag is removed then.
 TEST_CASE("real-content stacked_offset: coverage closer to the reference than ssaa:16",
-          "[real][!shouldfail]") {
+          "[real][!shouldfail][sanitizer-slow]") {
   check_real_scene("stacked_offset", 32, 24);
 }
 
@@ -213,7 +223,7 @@ TEST_CASE("real-content stacked_offset: coverage closer to the reference than ss
 // narrowed so that tan(fovy' / 2) = tan(fovy / 2) * 90 / 1080 (in coverage mode the image is
 // byte for byte the centre of the full-size one).
 TEST_CASE("real-content sphere_grid_per_triangle (central 160x90): coverage closer than ssaa:16",
-          "[real]") {
+          "[real][sanitizer-slow]") {
   TempDir dir;
   Scene scene = generate_and_load(dir, "sphere_grid_per_triangle");
   REQUIRE(scene.height == 1080);

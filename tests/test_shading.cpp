@@ -417,7 +417,8 @@ Scene lit_test_scene() {
 
 }  // namespace
 
-TEST_CASE("lit images are byte-identical across thread counts and tile sizes", "[shading]") {
+TEST_CASE("lit images are byte-identical across thread counts and tile sizes",
+          "[shading][threads]") {
   const Scene scene = lit_test_scene();
   for (const char* mode : {"coverage", "msaa:4", "aliased", "ssaa:3", "coverage-blend"}) {
     INFO("mode " << mode);

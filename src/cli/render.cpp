@@ -52,6 +52,9 @@ nlohmann::ordered_json stats_json(const RenderOptions& options, const RenderResu
   j["height"] = last.color.height;
   j["threads"] = s.threads;
   j["tile"] = s.tile;
+  // The Highway target the kernels ran on (e.g. "AVX2", "NEON", "SVE2"), so that a check
+  // across machines or emulated CPUs can tell which one it compared.
+  j["simd"] = build_info().simd_target;
   j["triangles"] = {{"in", s.triangles_in},
                     {"culled", s.triangles_culled},
                     {"backface_culled", s.triangles_backface_culled},

@@ -97,6 +97,19 @@ json parse_json(const std::string& text, const std::string& file) {
     }
     throw InputError(file + ":" + std::to_string(line) + ":" + std::to_string(column) + ": " +
                      detail);
+  } catch (const json::out_of_range& e) {
+    // A number beyond a double's range ("1e400"): nlohmann reports it as out_of_range 406,
+    // "[json.exception.out_of_range.406] number overflow parsing '1e400'", without a position.
+    // Found by tests/fuzz (fuzz_scene_json).
+    std::string detail = e.what();
+    if (const std::size_t at = detail.find("] "); at != std::string::npos) {
+      detail = detail.substr(at + 2);
+    }
+    for (char& c : detail) {
+      const auto byte = static_cast<unsigned char>(c);
+      if (byte < 0x20 || byte >= 0x7f) c = '?';
+    }
+    throw InputError(file + ": " + detail);
   }
 }
 
