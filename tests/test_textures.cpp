@@ -826,8 +826,8 @@ TEST_CASE("textures: the base colour texture's alpha multiplies into BLEND and M
         const double a = material.base_alpha * rgba[4 * i + 3] / 255.0;
         for (int c = 0; c < 3; ++c) {
           const double texel = srgb_decode(rgba[4 * i + c]);
-          const double linear = blend ? texel * a + bg[c] * (1.0 - a)
-                                      : (rgba[4 * i + 3] >= 128 ? texel : bg[c]);
+          const double linear =
+              blend ? texel * a + bg[c] * (1.0 - a) : (rgba[4 * i + 3] >= 128 ? texel : bg[c]);
           worst = std::max(worst, std::abs(image.rgb[3 * i + c] - srgb_encode_255(linear)));
         }
       }

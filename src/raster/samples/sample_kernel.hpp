@@ -150,5 +150,4 @@ SampleKernels sample_kernels_simd();
 /// The scalar twins: the same arithmetic one lane at a time (sample_kernel_scalar.cpp).
 SampleKernels sample_kernels_scalar();
 
-
 }  // namespace covrast::detail
