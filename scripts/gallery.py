@@ -159,8 +159,8 @@ def write_markdown(path, rows, skipped, size):
         "# Gallery: the glTF sample models, lit",
         "",
         "Written by `scripts/gallery.py` (not part of the test suite). Left: covrast, coverage "
-        f"mode, {size[0]}x{size[1]}, the file's materials and textures (docs/textures.md; "
-        "alpha modes not yet) under the script's light rig. Right: the publisher's screenshot, linked from `../shared/models/gltf` "
+        f"mode, {size[0]}x{size[1]}, the file's materials, textures (docs/textures.md) and "
+        "alpha modes (docs/transparency.md) under the script's light rig. Right: the publisher's screenshot, linked from `../shared/models/gltf` "
         "(not copied; licences vary per model). Framing, lights and materials differ from the "
         "publishers' viewers, so compare shapes and shading, not exact colours.",
         "",
