@@ -157,40 +157,6 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
   }
 }
 
-namespace {
-
-/// shade()'s perspective-correct weights at (x_px, y_px), the same operations; false where
-/// they are degenerate (shade() then takes vertex 0).
-bool perspective_weights(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside,
-                         double mu[3]) {
-  const double s = 1.0 / kSubpixelOne;
-  double x0 = t.x_fx8[0] * s, y0 = t.y_fx8[0] * s;
-  double x1 = t.x_fx8[1] * s, y1 = t.y_fx8[1] * s;
-  double x2 = t.x_fx8[2] * s, y2 = t.y_fx8[2] * s;
-  double area = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0);
-  double l0 = ((x2 - x1) * (y_px - y1) - (y2 - y1) * (x_px - x1)) / area;
-  double l1 = ((x0 - x2) * (y_px - y2) - (y0 - y2) * (x_px - x2)) / area;
-  double l2 = ((x1 - x0) * (y_px - y0) - (y1 - y0) * (x_px - x0)) / area;
-  if (clamp_inside) {
-    l0 = std::max(l0, 0.0);
-    l1 = std::max(l1, 0.0);
-    l2 = std::max(l2, 0.0);
-  }
-  double p0 = l0 * t.inv_w[0], p1 = l1 * t.inv_w[1], p2 = l2 * t.inv_w[2];
-  double sum = p0 + p1 + p2;
-  if (!(sum > 0.0)) {
-    mu[0] = 1.0;
-    mu[1] = mu[2] = 0.0;
-    return false;
-  }
-  mu[0] = p0 / sum;
-  mu[1] = p1 / sum;
-  mu[2] = p2 / sum;
-  return true;
-}
-
-}  // namespace
-
 double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
   const ShadingRecord& r = *t.shading;
   // Equal vertex alphas stay exact (the weights need not sum to exactly 1), so that a

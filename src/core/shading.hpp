@@ -14,13 +14,14 @@ namespace covrast::detail {
 /// then the material's lighting (core/shading.cpp). Out of line: it is the slow path.
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2);
 
-/// Colour of `t` at (x_px, y_px). With `clamp_inside`, barycentric weights are clamped to
-/// [0, 1] and renormalised, so a point outside the triangle takes the colour of the
-/// nearest part of it and colours never extrapolate.
+/// The perspective-correct barycentric weights mu0..mu2 of `t` at (x_px, y_px). With
+/// `clamp_inside`, the screen barycentrics are clamped to [0, 1] first, so a point outside the
+/// triangle takes the weights of the nearest part of it and attributes never extrapolate.
 ///   lambda_i = E_jk(p) / E_jk(v_i)   (screen-space barycentrics)
 ///   mu_i = lambda_i / w_i / sum_j (lambda_j / w_j)   (perspective-correct)
-inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
-  if (t.flat_color) return t.color[0];
+/// Returns false where they are degenerate (sum not > 0); mu is then (1, 0, 0).
+inline bool perspective_weights(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside,
+                                double mu[3]) {
   const double s = 1.0 / kSubpixelOne;
   double x0 = t.x_fx8[0] * s, y0 = t.y_fx8[0] * s;
   double x1 = t.x_fx8[1] * s, y1 = t.y_fx8[1] * s;
@@ -36,14 +37,29 @@ inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool cl
   }
   double p0 = l0 * t.inv_w[0], p1 = l1 * t.inv_w[1], p2 = l2 * t.inv_w[2];
   double sum = p0 + p1 + p2;
-  if (!(sum > 0.0)) return t.shading != nullptr ? shade_lit(t, 1.0, 0.0, 0.0) : t.color[0];
-  p0 /= sum;
-  p1 /= sum;
-  p2 /= sum;
-  if (t.shading != nullptr) return shade_lit(t, p0, p1, p2);
-  return glm::vec3(float(p0 * t.color[0].r + p1 * t.color[1].r + p2 * t.color[2].r),
-                   float(p0 * t.color[0].g + p1 * t.color[1].g + p2 * t.color[2].g),
-                   float(p0 * t.color[0].b + p1 * t.color[1].b + p2 * t.color[2].b));
+  if (!(sum > 0.0)) {
+    mu[0] = 1.0;
+    mu[1] = mu[2] = 0.0;
+    return false;
+  }
+  mu[0] = p0 / sum;
+  mu[1] = p1 / sum;
+  mu[2] = p2 / sum;
+  return true;
+}
+
+/// Colour of `t` at (x_px, y_px), at the weights of perspective_weights (vertex 0's colour
+/// where they are degenerate).
+inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
+  if (t.flat_color) return t.color[0];
+  double mu[3];
+  if (!perspective_weights(t, x_px, y_px, clamp_inside, mu)) {
+    return t.shading != nullptr ? shade_lit(t, 1.0, 0.0, 0.0) : t.color[0];
+  }
+  if (t.shading != nullptr) return shade_lit(t, mu[0], mu[1], mu[2]);
+  return glm::vec3(float(mu[0] * t.color[0].r + mu[1] * t.color[1].r + mu[2] * t.color[2].r),
+                   float(mu[0] * t.color[0].g + mu[1] * t.color[1].g + mu[2] * t.color[2].g),
+                   float(mu[0] * t.color[0].b + mu[1] * t.color[1].b + mu[2] * t.color[2].b));
 }
 
 /// Alpha of a non-opaque triangle (it has a ShadingRecord) at the perspective-correct
