@@ -26,7 +26,7 @@ test_packages=(clang libclang-rt-14-dev python3 chromium)
 aarch64_packages=(
   g++-aarch64-linux-gnu qemu-user-static file
   libtbb-dev:arm64 libhwy-dev:arm64 libspng-dev:arm64 libstb-dev:arm64 libdraco-dev:arm64
-  libtinyobjloader-dev:arm64 libtinygltf-dev:arm64
+  libtinyobjloader-dev:arm64 libtinygltf-dev:arm64 libturbojpeg0-dev:arm64
 )
 
 # Usage: scripts/setup.sh [--build-only | --aarch64]
