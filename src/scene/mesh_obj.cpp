@@ -429,15 +429,8 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
                      const std::filesystem::path& base_dir) {
   check_obj_text(text, display_name);
   ObjParser parser(display_name, base_dir);
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
-  std::size_t pos = 0;
-  std::size_t line_no = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    parser.read_line(text.substr(pos, end - pos), ++line_no);
-    pos = end + 1;
-  }
+  for_each_line(
+      text, [&](std::string_view line, std::size_t line_no) { parser.read_line(line, line_no); });
   return parser.finish();
 }
 

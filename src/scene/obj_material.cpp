@@ -171,15 +171,8 @@ long MtlLibrary::find(std::string_view name) const {
 void parse_mtl(std::string_view text, const std::string& display_name,
                const std::filesystem::path& directory, MtlLibrary& library) {
   MtlParser parser(display_name, directory, library);
-  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte order mark
-  std::size_t pos = 0;
-  std::size_t line_no = 0;
-  while (pos < text.size()) {
-    std::size_t end = text.find('\n', pos);
-    if (end == std::string_view::npos) end = text.size();
-    parser.read_line(text.substr(pos, end - pos), ++line_no);
-    pos = end + 1;
-  }
+  for_each_line(
+      text, [&](std::string_view line, std::size_t line_no) { parser.read_line(line, line_no); });
   parser.finish();
 }
 

@@ -92,4 +92,19 @@ inline bool parse_integer(std::string_view token, long long& value) {
   return ec == std::errc() && ptr == end;
 }
 
+/// Calls on_line(line, line_no) for each '\n'-separated line of an OBJ or MTL file (line
+/// numbers from 1), after a UTF-8 byte order mark.
+template <class OnLine>
+void for_each_line(std::string_view text, OnLine&& on_line) {
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);
+  std::size_t pos = 0;
+  std::size_t line_no = 0;
+  while (pos < text.size()) {
+    std::size_t end = text.find('\n', pos);
+    if (end == std::string_view::npos) end = text.size();
+    on_line(text.substr(pos, end - pos), ++line_no);
+    pos = end + 1;
+  }
+}
+
 }  // namespace covrast::detail
