@@ -314,6 +314,15 @@ TEST_CASE("KHR_draco_mesh_compression primitives decode with libdraco (.glb and 
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("missing.glb", missing.glb())),
                       Contains("missing.glb: mesh 0 primitive 0: KHR_draco_mesh_compression: "
                                "NORMAL names Draco attribute 7, which the stream does not hold"));
+  // The POSITION accessor's count must equal the stream's points (the extension requires it,
+  // and it bounds what covrast copies from the stream by the checked accessor count).
+  GltfBuilder miscounted = draco_document(stream, points + 1);
+  REQUIRE_THROWS_WITH(
+      covrast::load_mesh(dir.write("miscounted.glb", miscounted.glb())),
+      Contains("miscounted.glb: mesh 0 primitive 0: KHR_draco_mesh_compression: the stream "
+               "holds " +
+               std::to_string(points) + " points, the POSITION accessor's count is " +
+               std::to_string(points + 1) + " (they must be equal)"));
 }
 
 namespace {

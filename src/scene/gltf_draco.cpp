@@ -5,6 +5,7 @@
 #include "scene/gltf_draco.hpp"
 
 #include <covrast/error.hpp>
+#include <covrast/scene.hpp>
 
 #include <draco/compression/decode.h>
 #include <draco/core/decoder_buffer.h>
@@ -146,13 +147,25 @@ std::optional<std::string> without_draco_indices(std::string_view bytes) {
 
 DracoPrimitive decode_draco(const unsigned char* bytes, std::size_t size,
                             const std::map<std::string, DracoAttributeRef>& attributes,
-                            const std::string& name, const std::string& what) {
+                            std::optional<std::size_t> position_count, const std::string& name,
+                            const std::string& what) {
   draco::DecoderBuffer buffer;
   buffer.Init(reinterpret_cast<const char*>(bytes), size);
   draco::Decoder decoder;
   auto decoded = decoder.DecodeMeshFromBuffer(&buffer);
   if (!decoded.ok()) fail(name, what, "cannot decode: " + decoded.status().error_msg_string());
   const std::unique_ptr<draco::Mesh> mesh = std::move(decoded).value();
+  if (position_count && mesh->num_points() != *position_count) {
+    fail(name, what,
+         "the stream holds " + std::to_string(mesh->num_points()) +
+             " points, the POSITION accessor's count is " + std::to_string(*position_count) +
+             " (they must be equal)");
+  }
+  if (std::uint64_t{mesh->num_faces()} * 3 > kMaxAccessorElements) {
+    fail(name, what,
+         "the stream holds " + std::to_string(mesh->num_faces()) + " triangles, more than the " +
+             std::to_string(kMaxAccessorElements / 3) + " an index accessor may hold");
+  }
   DracoPrimitive out;
   out.vertex_count = mesh->num_points();
   for (const auto& [attribute_name, ref] : attributes) {

@@ -42,9 +42,13 @@ struct DracoAttributeRef {
 };
 
 /// Decodes the Draco mesh in `bytes` (the extension's bufferView). Throws InputError naming
-/// `name` and `what` (the primitive) when the stream does not decode or lacks an attribute.
+/// `name` and `what` (the primitive) when the stream does not decode, lacks an attribute, holds
+/// a number of points other than `position_count` (the POSITION accessor's count, when the
+/// primitive has one: the extension requires them equal) or more triangle corners than an
+/// accessor may hold (kMaxAccessorElements), checked before covrast copies anything.
 DracoPrimitive decode_draco(const unsigned char* bytes, std::size_t size,
                             const std::map<std::string, DracoAttributeRef>& attributes,
-                            const std::string& name, const std::string& what);
+                            std::optional<std::size_t> position_count, const std::string& name,
+                            const std::string& what);
 
 }  // namespace covrast::detail

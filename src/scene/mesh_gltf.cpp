@@ -617,7 +617,13 @@ class GltfMeshBuilder {
           model_.accessors[static_cast<std::size_t>(accessor->second)].normalized;
       refs[key] = {static_cast<std::uint32_t>(id.GetNumberAsInt()), normalized};
     }
-    return decode_draco(bytes, size, refs, name_, what);
+    std::optional<std::size_t> position_count;
+    const auto position = primitive.attributes.find("POSITION");
+    if (position != primitive.attributes.end() && position->second >= 0 &&
+        static_cast<std::size_t>(position->second) < model_.accessors.size()) {
+      position_count = model_.accessors[static_cast<std::size_t>(position->second)].count;
+    }
+    return decode_draco(bytes, size, refs, position_count, name_, what);
   }
 
   /// Attribute `attribute` of the primitive (its Draco values first, else its accessor), or
