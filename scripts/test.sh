@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
 # Installs missing dependencies, builds one preset (default: release) and runs the whole test
-# suite: for the release preset first the g++-vs-clang byte-identity check
-# (scripts/check-compilers.sh), then ctest, then the robustness steps (docs/testing.md): the
-# suite under AddressSanitizer and UndefinedBehaviorSanitizer (the fuzz preset's build, which
-# also replays the fuzz seeds and regressions), each fuzz target for 20 s, and the aarch64
-# byte-identity check under emulation (a subset).
+# suite: ctest, then for the release preset the robustness steps (docs/testing.md): one clang
+# build of everything under AddressSanitizer and UndefinedBehaviorSanitizer (the fuzz preset)
+# runs the suite, replays the fuzz seeds and regressions, serves the g++-vs-clang byte-identity
+# check (scripts/check-compilers.sh) and runs each fuzz target for a few seconds; a
+# ThreadSanitizer build runs the [threads] tests; and the aarch64 byte-identity check runs
+# under emulation (a subset).
 # Each step prints its wall time. Usage: scripts/test.sh [preset]
 set -euo pipefail
 
@@ -20,22 +21,23 @@ step() {  # NAME COMMAND...: runs the command and prints its wall time
 }
 
 step "build $preset" bash scripts/build.sh "$preset"
-if [ "$preset" = release ]; then
-  step "g++ vs clang" bash scripts/check-compilers.sh "build/$preset/covrast"
-fi
 step "ctest $preset" ctest --preset "$preset"
 [ "$preset" = release ] || exit 0
 
-# ASan + UBSan: one clang build (-O1) serves the whole suite and the fuzz targets. Sanitizer
-# builds do not register the tests tagged [sanitizer-slow]; the black-box report, Chromium and
-# install tests ran above (docs/testing.md says which and why).
+# ASan + UBSan: one clang build (-O1, -Werror, everything) serves the whole suite, the fuzz
+# targets and the comparison with g++. Sanitizer builds do not register the tests tagged
+# [sanitizer-slow]; the black-box report, Chromium and install tests ran above
+# (docs/testing.md says which and why).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-step "build fuzz (ASan+UBSan)" bash scripts/build.sh fuzz
+step "build fuzz (clang, ASan+UBSan)" bash scripts/build.sh fuzz
 step "ctest fuzz (ASan+UBSan)" ctest --preset fuzz -E '^(report_quick|report_in_chromium|install_consumer)$'
-step "fuzz targets, 20 s each" bash scripts/fuzz.sh --no-build 20
+step "g++ vs clang" bash scripts/check-compilers.sh --clang-build build/fuzz "build/$preset/covrast"
+step "fuzz targets, 10 s each" bash scripts/fuzz.sh --no-build 10
 
-# No TSan step: with Debian's oneTBB (not built with TSan) the [threads] tests give about a
-# thousand reports, all on data handed between workers through TBB (docs/testing.md).
+# TSan: the tests that run work on several threads, in a clang build whose kernels are
+# compiled for one SIMD target (the other targets' kernels hold no shared state).
+step "build tsan" bash -c 'cmake --preset tsan >/dev/null && cmake --build --preset tsan --target covrast_thread_tests'
+step "TSan: [threads] tests, renders" bash scripts/tsan.sh
 
 step "aarch64 (qemu, subset)" bash scripts/check-aarch64.sh --quick "build/$preset/covrast"

@@ -1,10 +1,11 @@
 // Pipeline: running independent pieces of work at once (renderer.hpp, for_each_in_parallel),
 // so that programs on the public API, like covrast test, need no scheduler of their own.
+#include "fork_join.hpp"
+
 #include <covrast/renderer.hpp>
 
-#include <tbb/info.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
+#include <oneapi/tbb/info.h>
+#include <oneapi/tbb/task_arena.h>
 
 #include <atomic>
 #include <exception>
@@ -21,20 +22,20 @@ void for_each_in_parallel(std::size_t count, int threads,
   std::atomic<bool> failed{false};
   std::exception_ptr first;
   std::mutex first_mutex;
-  arena.execute([&] {
+  detail::fork_join_execute(arena, [&] {
     // One index per task: each piece is a whole frame or more, far above the scheduling cost.
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, count, 1),
-                      [&](const tbb::blocked_range<std::size_t>& range) {
-                        for (std::size_t i = range.begin(); i < range.end(); ++i) {
-                          if (failed.load(std::memory_order_relaxed)) return;
-                          try {
-                            work(i);
-                          } catch (...) {
-                            const std::lock_guard<std::mutex> lock(first_mutex);
-                            if (!failed.exchange(true)) first = std::current_exception();
-                          }
-                        }
-                      });
+    detail::fork_join_for(tbb::blocked_range<std::size_t>(0, count, 1),
+                          [&](const tbb::blocked_range<std::size_t>& range) {
+                            for (std::size_t i = range.begin(); i < range.end(); ++i) {
+                              if (failed.load(std::memory_order_relaxed)) return;
+                              try {
+                                work(i);
+                              } catch (...) {
+                                const std::lock_guard<std::mutex> lock(first_mutex);
+                                if (!failed.exchange(true)) first = std::current_exception();
+                              }
+                            }
+                          });
   });
   if (first) std::rethrow_exception(first);
 }

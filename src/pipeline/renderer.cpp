@@ -11,6 +11,7 @@
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
 #include "core/tile_raster.hpp"
+#include "fork_join.hpp"
 #include "geometry/frontend.hpp"
 #include "post/fxaa.hpp"
 #include "raster/rasterizers.hpp"
@@ -20,7 +21,6 @@
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/enumerable_thread_specific.h>
 #include <oneapi/tbb/info.h>
-#include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
 
 #include <algorithm>
@@ -75,10 +75,10 @@ void post_process_fxaa(const FxaaOptions& options, Image& input, detail::LumaPla
   luma.height = frame.height;
   luma.luma.resize(std::size_t(frame.width) * frame.height);
   const auto rows = tbb::blocked_range<int>(0, frame.height, kPostRowsPerTask);
-  tbb::parallel_for(rows, [&](const tbb::blocked_range<int>& r) {
+  detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
     detail::fxaa_luma_rows(input, luma, r.begin(), r.end());
   });
-  tbb::parallel_for(rows, [&](const tbb::blocked_range<int>& r) {
+  detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
     detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end());
   });
 }
@@ -180,12 +180,12 @@ void Renderer::Impl::set_up_triangles() {
       blocks.emplace_back(i, v);
     }
   }
-  tbb::parallel_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
+  detail::fork_join_for(std::size_t(0), blocks.size(), [&](std::size_t b) {
     auto [instance, begin] = blocks[b];
     std::size_t end = std::min(begin + kVerticesPerBlock, front_end.vertex_count(instance));
     front_end.transform_vertices(instance, begin, end);
   });
-  tbb::parallel_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
+  detail::fork_join_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
     // Room for one output per input in the chunk's slice (clipping can add more, and then
     // the chunk moves to its own array).
     chunk_triangles[c].reset(static_cast<TriangleSetup*>(setup_storage.data()) +
@@ -198,19 +198,19 @@ void Renderer::Impl::set_up_triangles() {
 }
 
 void Renderer::Impl::bin_triangles() {
-  tbb::parallel_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
+  detail::fork_join_for(std::uint32_t(0), front_end.chunk_count(), [&](std::uint32_t c) {
     detail::bin_chunk(grid, chunk_bounds[c], chunk_bins[c], bin_scratch.local());
   });
 }
 
 void Renderer::Impl::raster_tiles(const detail::FrameTarget& target) {
-  tbb::parallel_for(tbb::blocked_range<int>(0, grid.tile_count(), 1),
-                    [&](const tbb::blocked_range<int>& r) {
-                      detail::TileRasterizer& raster = *rasterizers.local();
-                      for (int tile = r.begin(); tile < r.end(); ++tile) {
-                        raster_tile(raster, tile, target);
-                      }
-                    });
+  detail::fork_join_for(tbb::blocked_range<int>(0, grid.tile_count(), 1),
+                        [&](const tbb::blocked_range<int>& r) {
+                          detail::TileRasterizer& raster = *rasterizers.local();
+                          for (int tile = r.begin(); tile < r.end(); ++tile) {
+                            raster_tile(raster, tile, target);
+                          }
+                        });
 }
 
 void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
@@ -299,7 +299,7 @@ RenderResult Renderer::render_frame() {
                                    im.scene.background_linear};
   const std::uint64_t overflows_before = im.begin_frame_counters();
   Clock::time_point t0, t1, t2, t3, t4;
-  im.arena.execute([&] {
+  detail::fork_join_execute(im.arena, [&] {
     t0 = Clock::now();
     im.set_up_triangles();
     t1 = Clock::now();

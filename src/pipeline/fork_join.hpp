@@ -1,0 +1,96 @@
+// Pipeline: the oneTBB loops of the pipeline, with the ordering they guarantee told to
+// ThreadSanitizer.
+//
+// oneTBB guarantees fork-join order: everything the caller did before a parallel_for (or a
+// task_arena::execute) happens before every task of it, and every task happens before the
+// call returns. Tasks of one loop are not ordered among themselves. That order is made by
+// the scheduler inside libtbb.so, and Debian's libtbb.so is not built with TSan, so a TSan
+// build sees none of it and reports every value handed to or from a task as a race. Here the
+// two edges are announced by hand with two sync objects per call: `fork` (released by the
+// caller before the loop, acquired at the start of each task) and `join` (released at the
+// end of each task, acquired by the caller after the loop). No task acquires `join`, so one
+// task's writes are never ordered before another's reads: a real race between tasks (two
+// tiles writing one pixel) is still reported. Outside a TSan build the annotations are empty.
+#pragma once
+
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#if defined(__SANITIZE_THREAD__)
+#define COVRAST_TSAN 1
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+#define COVRAST_TSAN 1
+#endif
+#endif
+
+#ifdef COVRAST_TSAN
+#include <sanitizer/tsan_interface.h>
+#endif
+
+namespace covrast::detail {
+
+/// The two happens-before edges of one fork-join call (see above).
+class ForkJoinOrder {
+ public:
+  /// Before the tasks start: the caller's writes so far reach every task.
+  ForkJoinOrder() { release(&fork_); }
+  ForkJoinOrder(const ForkJoinOrder&) = delete;
+  ForkJoinOrder& operator=(const ForkJoinOrder&) = delete;
+  /// At the start of a task.
+  void enter_task() const { acquire(&fork_); }
+  /// At the end of a task.
+  void leave_task() const { release(&join_); }
+  /// After the call returned: every task's writes reach the caller.
+  void joined() const { acquire(&join_); }
+
+ private:
+#ifdef COVRAST_TSAN
+  static void release(const void* sync) { __tsan_release(const_cast<void*>(sync)); }
+  static void acquire(const void* sync) { __tsan_acquire(const_cast<void*>(sync)); }
+#else
+  static void release(const void*) {}
+  static void acquire(const void*) {}
+#endif
+  char fork_ = 0;
+  char join_ = 0;
+};
+
+/// tbb::parallel_for(range, body), with its order told to TSan.
+template <class Range, class Body>
+void fork_join_for(const Range& range, const Body& body) {
+  const ForkJoinOrder order;
+  tbb::parallel_for(range, [&](const Range& r) {
+    order.enter_task();
+    body(r);
+    order.leave_task();
+  });
+  order.joined();
+}
+
+/// tbb::parallel_for(first, last, body): body(i) for each index, with its order told to TSan.
+template <class Index, class Body>
+void fork_join_for(Index first, Index last, const Body& body) {
+  const ForkJoinOrder order;
+  tbb::parallel_for(first, last, [&](Index i) {
+    order.enter_task();
+    body(i);
+    order.leave_task();
+  });
+  order.joined();
+}
+
+/// arena.execute(work), which may hand `work` to a worker of the arena, with its order told
+/// to TSan.
+template <class Work>
+void fork_join_execute(tbb::task_arena& arena, const Work& work) {
+  const ForkJoinOrder order;
+  arena.execute([&] {
+    order.enter_task();
+    work();
+    order.leave_task();
+  });
+  order.joined();
+}
+
+}  // namespace covrast::detail
