@@ -20,6 +20,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "test_cli_run.hpp"
@@ -274,6 +275,22 @@ TEST_CASE("cli: render of a good scene writes a PNG of the requested size", "[cl
   const std::string header = "Pf\n40 8\n-1.0\n";
   CHECK(pfm.size() == header.size() + 40 * 8 * 4);
   CHECK(pfm.compare(0, header.size(), header) == 0);
+}
+
+TEST_CASE("cli: --threads above the hardware threads prints nothing from the scheduler", "[cli]") {
+  // oneTBB's default limit is the hardware threads; without covrast raising it for an explicit
+  // count, the render still succeeded but oneTBB printed "TBB Warning: The number of workers
+  // is currently limited ..." to stderr, even with --quiet.
+  TempDir dir;
+  write_good_scene(dir);
+  const int threads = int(std::thread::hardware_concurrency()) + 3;
+  const RunResult r = run_cli(
+      dir, {"render", (dir / "scene.json").string(), "-o", (dir / "out.png").string(), "--size",
+            "512x512", "--tile", "8", "--threads", std::to_string(threads), "--quiet", "--stats"});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  CHECK(r.err.empty());
+  CHECK(nlohmann::json::parse(r.out).at("threads") == threads);
 }
 
 TEST_CASE("cli: scene warnings go to stderr; --strict makes them errors", "[cli]") {

@@ -1,5 +1,5 @@
 // Pipeline: the oneTBB loops of the pipeline, with the ordering they guarantee told to
-// ThreadSanitizer.
+// ThreadSanitizer, and the allowance that lets an explicit thread count exceed the cores.
 //
 // oneTBB guarantees fork-join order: everything the caller did before a parallel_for (or a
 // task_arena::execute) happens before every task of it, and every task happens before the
@@ -13,8 +13,13 @@
 // tiles writing one pixel) is still reported. Outside a TSan build the annotations are empty.
 #pragma once
 
+#include <oneapi/tbb/global_control.h>
+#include <oneapi/tbb/info.h>
 #include <oneapi/tbb/parallel_for.h>
 #include <oneapi/tbb/task_arena.h>
+
+#include <cstddef>
+#include <optional>
 
 #if defined(__SANITIZE_THREAD__)
 #define COVRAST_TSAN 1
@@ -54,6 +59,23 @@ class ForkJoinOrder {
 #endif
   char fork_ = 0;
   char join_ = 0;
+};
+
+/// While it lives, oneTBB may run `threads` threads in all when that is more than the
+/// hardware threads, its default limit: an arena of `threads` (an explicit `--threads`)
+/// then gets them, where oneTBB would otherwise give fewer and print "TBB Warning: The number
+/// of workers is currently limited" to stderr. oneTBB keeps the smallest of the limits in
+/// force, so a limit the embedding program set stays in force.
+class ThreadAllowance {
+ public:
+  explicit ThreadAllowance(int threads) {
+    if (threads > tbb::info::default_concurrency()) {
+      limit_.emplace(tbb::global_control::max_allowed_parallelism, std::size_t(threads));
+    }
+  }
+
+ private:
+  std::optional<tbb::global_control> limit_;
 };
 
 /// tbb::parallel_for(range, body), with its order told to TSan.

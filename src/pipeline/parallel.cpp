@@ -18,6 +18,7 @@ void for_each_in_parallel(std::size_t count, int threads,
   if (threads < 0 || threads > kMaxThreads) {
     throw InputError("thread count must be 0..." + std::to_string(kMaxThreads));
   }
+  const detail::ThreadAllowance thread_allowance(threads);
   tbb::task_arena arena(threads > 0 ? threads : tbb::info::default_concurrency());
   std::atomic<bool> failed{false};
   std::exception_ptr first;

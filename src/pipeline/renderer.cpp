@@ -104,6 +104,7 @@ struct Renderer::Impl {
   std::vector<detail::ChunkSetups> chunk_triangles;
   std::vector<std::vector<detail::PixelBounds16>> chunk_bounds;  ///< per triangle, for binning
   std::vector<detail::ChunkBins> chunk_bins;
+  detail::ThreadAllowance thread_allowance;  ///< before the arena, which it outlives
   tbb::task_arena arena;
   tbb::enumerable_thread_specific<std::vector<std::uint32_t>> bin_scratch;
   tbb::enumerable_thread_specific<std::unique_ptr<detail::TileRasterizer>> rasterizers;
@@ -121,6 +122,7 @@ struct Renderer::Impl {
         grid(w, h, o.tile),
         front_end(s, w, h, o.cull_hidden_backfaces),
         setup_storage(front_end.triangle_count() * sizeof(TriangleSetup)),
+        thread_allowance(t),
         arena(t),
         rasterizers(
             [mode = o.mode, tile = o.tile] { return detail::make_tile_rasterizer(mode, tile); }) {
