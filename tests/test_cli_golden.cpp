@@ -194,6 +194,12 @@ TEST_CASE("covrast test: malformed manifests exit 2 naming the case and field", 
   expect_error(head + R"(, "tolernce": {}}]})", "case 'a': \"tolernce\" is not a manifest key");
   expect_error(R"({"cases": [{"name": "a", "golden": "g.png"}]})",
                "case 'a': \"scene\" is missing");
+  // Found by fuzz_manifest: a key or a name holding a newline broke the one-line message.
+  expect_error(head + R"(, "gold\nen": 1}]})", "case 'a': \"gold\\nen\" is not a manifest key");
+  expect_error(R"({"cases": [{"name": "a\nb", "scene": "tri.json", "golden": "g.png"}]})",
+               "case 'a\\nb': \"name\" contains a control character");
+  expect_error(R"({"cases": [{"name": "a\tb", "scene": "tri.json", "golden": "g.png"}]})",
+               "case 'a\\tb': \"name\" contains a control character");
   expect_error(head + R"(, "mode": "msaa:3"}]})", "case 'a': \"mode\"");
   expect_error(head + R"(, "size": "0x10"}]})", "case 'a': \"size\"");
   expect_error(head + R"(, "tolerance": {"max_diff": 300}}]})",

@@ -24,13 +24,20 @@ using Json = nlohmann::json;
 /// The manifest's largest size: a CI manifest is a few kilobytes; this bounds the read.
 constexpr std::uintmax_t kMaxManifestBytes = 64u << 20;
 
+/// `text` with control characters, quotes and backslashes escaped as JSON writes them, for
+/// error messages, which must stay one line whatever the manifest's keys and names hold.
+std::string escaped(const std::string& text) {
+  const std::string quoted = Json(text).dump(-1, ' ', false, Json::error_handler_t::replace);
+  return quoted.substr(1, quoted.size() - 2);
+}
+
 /// Where an error is: "manifest.json: case 'name'" or "manifest.json: defaults".
 struct Where {
   const std::filesystem::path& file;
   std::string part;
   [[noreturn]] void fail(const std::string& field, const std::string& problem) const {
     throw InputError(file.string() + ": " + part + ": " +
-                     (field.empty() ? "" : "\"" + field + "\" ") + problem);
+                     (field.empty() ? "" : "\"" + escaped(field) + "\" ") + problem);
   }
 };
 
@@ -141,7 +148,7 @@ TestCase read_case(const Json& object, std::size_t index, const TestCase& defaul
   Where where{manifest, "case " + std::to_string(index + 1)};
   if (!object.is_object()) where.fail("", "must be an object");
   if (object.contains("name") && object.at("name").is_string()) {
-    where.part = "case '" + object.at("name").get<std::string>() + "'";
+    where.part = "case '" + escaped(object.at("name").get<std::string>()) + "'";
   }
   check_keys(object, {"name", "scene", "golden", "mode", "size", "tolerance", "skip"}, where);
   for (const char* key : {"name", "scene", "golden"}) {
@@ -149,6 +156,11 @@ TestCase read_case(const Json& object, std::size_t index, const TestCase& defaul
   }
   TestCase c = defaults;
   c.name = string_field(object, "name", where);
+  // Names go into messages, the runner's lines and report files: one printable line each.
+  if (std::any_of(c.name.begin(), c.name.end(),
+                  [](char ch) { return static_cast<unsigned char>(ch) < 0x20 || ch == 0x7f; })) {
+    where.fail("name", "contains a control character (a newline, a tab, ...)");
+  }
   const std::filesystem::path folder = manifest.parent_path();
   c.scene = folder / string_field(object, "scene", where);
   c.golden = folder / string_field(object, "golden", where);
