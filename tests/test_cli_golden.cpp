@@ -200,6 +200,9 @@ TEST_CASE("covrast test: malformed manifests exit 2 naming the case and field", 
                "case 'a\\nb': \"name\" contains a control character");
   expect_error(R"({"cases": [{"name": "a\tb", "scene": "tri.json", "golden": "g.png"}]})",
                "case 'a\\tb': \"name\" contains a control character");
+  expect_error(head + R"(, "mode": "coverage\n"}]})",
+               "case 'a': \"mode\" unknown mode 'coverage?'");
+  expect_error(head + R"(, "size": "4x4\n"}]})", "case 'a': \"size\"");
   expect_error(head + R"(, "mode": "msaa:3"}]})", "case 'a': \"mode\"");
   expect_error(head + R"(, "size": "0x10"}]})", "case 'a': \"size\"");
   expect_error(head + R"(, "tolerance": {"max_diff": 300}}]})",

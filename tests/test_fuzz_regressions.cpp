@@ -4,6 +4,7 @@
 #include "test_tempdir.hpp"
 
 #include <covrast/error.hpp>
+#include <covrast/options.hpp>
 #include <covrast/scene.hpp>
 
 #include <catch2/catch.hpp>
@@ -50,4 +51,24 @@ TEST_CASE("fuzz regression: a JSON number beyond a double's range is an input er
       R"({"width": 16, "height": 9, "camera": {"eye": [0, 0, 1.7976931348623157e308]}, "meshes": []})");
   CHECK(message.find("number overflow") == std::string::npos);
   CHECK(message.rfind(file + ": ", 0) == 0);
+}
+
+// fuzz_manifest, crash-41e35426: a manifest mode of "coverage" plus an escaped newline came
+// back in parse_render_mode's message as it was, so the error took two lines. Every
+// InputError now turns control characters into '?'.
+TEST_CASE("fuzz regression: an input error is one line whatever the input quoted in it",
+          "[fuzz][cli]") {
+  for (const char* mode : {"coverage\n", "msaa:\t4", "ssaa:4\r", "aliased\x7f"}) {
+    INFO(mode);
+    try {
+      covrast::parse_render_mode(mode);
+      FAIL("accepted");
+    } catch (const covrast::InputError& e) {
+      const std::string message = e.what();
+      CHECK(message.find_first_of("\n\t\r\x7f") == std::string::npos);
+      CHECK(message.rfind("unknown mode '", 0) == 0);
+    }
+  }
+  // UTF-8 (a file name, say) is kept as it is.
+  CHECK(std::string(covrast::InputError("a\nb: caf\xc3\xa9").what()) == "a?b: caf\xc3\xa9");
 }

@@ -9,10 +9,22 @@
 namespace covrast {
 
 /// Bad input or usage. what() is one line that names the file (when there is one) and
-/// the problem, e.g. "scenes/a.json:3:14: expected ',' or '}'".
+/// the problem, e.g. "scenes/a.json:3:14: expected ',' or '}'". Messages quote what the
+/// input said (a mode, a size, a key), so the constructor makes sure of the one line: each
+/// control character (a newline, a tab, ...) becomes '?'.
 class InputError : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit InputError(const std::string& message) : std::runtime_error(one_line(message)) {}
+  explicit InputError(const char* message) : InputError(std::string(message)) {}
+
+ private:
+  static std::string one_line(std::string text) {
+    for (char& c : text) {
+      const auto byte = static_cast<unsigned char>(c);
+      if (byte < 0x20 || byte == 0x7f) c = '?';
+    }
+    return text;
+  }
 };
 
 }  // namespace covrast
