@@ -878,7 +878,7 @@ Scene determinism_scene(int width, int height) {
 
 TEST_CASE(
     "sample-based modes give identical bytes for every thread count, tile size and SIMD target",
-    "[ssaa]") {
+    "[ssaa][threads]") {
   const Scene scene = determinism_scene(97, 61);
   const Scene small = determinism_scene(41, 27);
   const std::int64_t targets =
