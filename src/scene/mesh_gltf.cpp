@@ -610,20 +610,27 @@ class GltfMeshBuilder {
       if (!id.IsInt() || id.GetNumberAsInt() < 0) {
         fail(name_, where + ": attribute " + printable(key) + " needs a Draco id");
       }
-      const auto accessor = primitive.attributes.find(key);
-      const bool normalized =
-          accessor != primitive.attributes.end() && accessor->second >= 0 &&
-          static_cast<std::size_t>(accessor->second) < model_.accessors.size() &&
-          model_.accessors[static_cast<std::size_t>(accessor->second)].normalized;
-      refs[key] = {static_cast<std::uint32_t>(id.GetNumberAsInt()), normalized};
+      const tinygltf::Accessor* accessor = attribute_accessor(primitive, key);
+      refs[key] = {static_cast<std::uint32_t>(id.GetNumberAsInt()),
+                   accessor != nullptr && accessor->normalized};
     }
-    std::optional<std::size_t> position_count;
-    const auto position = primitive.attributes.find("POSITION");
-    if (position != primitive.attributes.end() && position->second >= 0 &&
-        static_cast<std::size_t>(position->second) < model_.accessors.size()) {
-      position_count = model_.accessors[static_cast<std::size_t>(position->second)].count;
+    const tinygltf::Accessor* position = attribute_accessor(primitive, "POSITION");
+    return decode_draco(
+        bytes, size, refs,
+        position != nullptr ? std::optional<std::size_t>(position->count) : std::nullopt, name_,
+        what);
+  }
+
+  /// The accessor of the primitive's attribute `name`, or nullptr when it has none or names
+  /// one that does not exist (reading the attribute reports that).
+  const tinygltf::Accessor* attribute_accessor(const tinygltf::Primitive& primitive,
+                                               const std::string& name) const {
+    const auto it = primitive.attributes.find(name);
+    if (it == primitive.attributes.end() || it->second < 0 ||
+        static_cast<std::size_t>(it->second) >= model_.accessors.size()) {
+      return nullptr;
     }
-    return decode_draco(bytes, size, refs, position_count, name_, what);
+    return &model_.accessors[static_cast<std::size_t>(it->second)];
   }
 
   /// Attribute `attribute` of the primitive (its Draco values first, else its accessor), or
