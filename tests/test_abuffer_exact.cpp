@@ -231,6 +231,13 @@ TEST_CASE("coverage resolve: exact-area paths match the per-sample list resolve"
       // stack several layers) merge within their disjoint set or turn into samples; both
       // renders do the same there, so this bound covers them too.
       CHECK(c.max_diff_srgb8 <= 1);
+      // The exact-area paths ran in the fast render and not in the per-sample one, which
+      // resolved every pixel with fragments by its samples.
+      const covrast::CoverageResolvePaths &fast = r.fast.stats.resolve_paths,
+                                          &masks = r.masks.stats.resolve_paths;
+      CHECK(fast.layer_sums + fast.disjoint + fast.front_layer > 1000);
+      CHECK(masks.layer_sums + masks.disjoint + masks.front_layer == 0);
+      CHECK(masks.samples + masks.clipped > fast.samples + fast.clipped);
     }
     ++scene_index;
   }

@@ -625,6 +625,7 @@ TEST_CASE("coverage mode: more fragments than a pixel list holds keep their plac
                    << encode8(r.g) << ", " << encode8(r.b) << "); fragment overflows "
                    << result.stats.fragment_overflows);
     CHECK(result.stats.fragment_overflows > 0);
+    CHECK(result.stats.resolve_paths.overflowed > 0);  // the overflow path ran
     // A pixel whose list overflows while its fragments are not one disjoint set resolves
     // from its 256 samples, where a straight edge can misplace up to 1/16 of a pixel.
     CHECK(c.max_diff_linear <= kSampledToleranceLinear);
@@ -932,7 +933,8 @@ TEST_CASE("coverage mode: two interpenetrating surfaces split pixels exactly", "
   const std::vector<TriangleSetup> tris = screen_triangles(s);
   REQUIRE(tris.size() == 2);
   const TriangleSetup &first = tris[0], &second = tris[1];
-  const Image img = render(s, ModeKind::Coverage).color;
+  const auto result = render(s, ModeKind::Coverage);
+  const Image& img = result.color;
   constexpr int kSamples = 512;
   int crossed = 0, worst = 0;
   for (int y = 0; y < s.height; ++y) {
@@ -964,6 +966,8 @@ TEST_CASE("coverage mode: two interpenetrating surfaces split pixels exactly", "
                                                       << worst << "/255");
   CHECK(crossed > 40);
   CHECK(worst <= 1);
+  // Every crossed pixel took the polygon-clipping path, and no other pixel did.
+  CHECK(result.stats.resolve_paths.clipped == std::uint64_t(crossed));
 }
 
 TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sample", "[coverage]") {
@@ -977,8 +981,11 @@ TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sampl
     add_triangle_pair(s, a, red, b, sky, one_mesh);
     const std::vector<TriangleSetup> tris = screen_triangles(s);
     REQUIRE(tris.size() == 2);
-    const Comparison c = compare(render(s, ModeKind::Coverage).color, reference_render(s, tris));
+    const auto result = render(s, ModeKind::Coverage);
+    const Comparison c = compare(result.color, reference_render(s, tris));
     WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes") << ": " << describe(c));
+    // Where the crossing line meets a triangle's edge, the samples decide.
+    CHECK(result.stats.resolve_paths.samples > 0);
     CHECK(c.max_diff_linear <= kMaskToleranceLinear);
     CHECK(c.mean_diff8 < 0.1);
   }
@@ -1098,6 +1105,8 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
   // some with vertex colours, over small ones; rendered with the fast paths and without.
   std::mt19937 rng(2024);
   std::uniform_real_distribution<double> coord(-60.0, 220.0), depth(-0.5, 0.5);
+  // Pixels the whole-tile and whole-block paths resolved, with them and without.
+  std::uint64_t fast_blocks = 0, slow_blocks = 0;
   for (int round = 0; round < 12; ++round) {
     Scene s = make_scene(160, 120, from_codes(10, 20, 30));
     const int big = 3 + round % 5;
@@ -1133,11 +1142,16 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
       covrast::detail::testing::coverage_hooks.pixel_path_only = true;
       const auto slow = covrast::render(s, o);
       covrast::detail::testing::coverage_hooks.pixel_path_only = false;
+      fast_blocks += fast.stats.resolve_paths.uniform_tile + fast.stats.resolve_paths.uniform_block;
+      slow_blocks += slow.stats.resolve_paths.uniform_tile + slow.stats.resolve_paths.uniform_block;
       REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
       CHECK(fast.color.rgb == slow.color.rgb);
       CHECK(fast.depth.depth == slow.depth.depth);
     }
   }
+  // The fast paths decided many pixels; switched off, only tiles that no triangle touches
+  // are resolved whole.
+  CHECK(fast_blocks > slow_blocks + 10000);
 }
 
 TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from their lists",
@@ -1158,18 +1172,43 @@ TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from th
   covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
   for (int tile : {16, 64}) {
     INFO("tile " << tile);
-    hooks.count_layer_resolves = true;
-    hooks.layer_resolves = 0;
-    const Image with_sums = render(s, ModeKind::Coverage, 2, tile).color;
-    const std::uint64_t used = hooks.layer_resolves.exchange(0);
+    const auto sums = render(s, ModeKind::Coverage, 2, tile);
+    const Image& with_sums = sums.color;
     hooks.list_resolve = true;
-    const Image lists_only = render(s, ModeKind::Coverage, 2, tile).color;
-    const std::uint64_t used_forced = hooks.layer_resolves.load();
+    const auto lists = render(s, ModeKind::Coverage, 2, tile);
+    const Image& lists_only = lists.color;
     hooks.list_resolve = false;
-    hooks.count_layer_resolves = false;
-    CHECK(used > 1000);       // the sums resolved many pixels...
-    CHECK(used_forced == 0);  // ...and none when forced off
+    CHECK(sums.stats.resolve_paths.layer_sums > 1000);  // the sums resolved many pixels...
+    CHECK(lists.stats.resolve_paths.layer_sums == 0);   // ...and none when forced off
+    // ...which the list resolve then adds up as disjoint fragments.
+    CHECK(lists.stats.resolve_paths.disjoint >= sums.stats.resolve_paths.layer_sums);
     REQUIRE(with_sums.rgb.size() == lists_only.rgb.size());
     CHECK(with_sums.rgb == lists_only.rgb);
   }
+}
+
+TEST_CASE("coverage resolve: every pixel takes exactly one counted path", "[coverage]") {
+  // RenderStats::resolve_paths adds up to the image for every tile size, and the same pixels
+  // take the same paths whatever the thread count (a path is chosen per pixel).
+  const Scene s = default_like_scene();
+  const std::uint64_t pixels = std::uint64_t(s.width) * std::uint64_t(s.height);
+  for (int tile : {8, 16, 64}) {
+    INFO("tile " << tile);
+    const auto one = render(s, ModeKind::Coverage, 1, tile);
+    const auto two = render(s, ModeKind::Coverage, 2, tile);
+    const covrast::CoverageResolvePaths &a = one.stats.resolve_paths, &b = two.stats.resolve_paths;
+    CHECK(a.total() == pixels);
+    CHECK(b.total() == pixels);
+    CHECK(a.layer_sums == b.layer_sums);
+    CHECK(a.front_layer == b.front_layer);
+    CHECK(a.samples == b.samples);
+    CHECK(a.clipped == b.clipped);
+    CHECK(a.opaque + a.uniform_block + a.uniform_tile ==
+          b.opaque + b.uniform_block + b.uniform_tile);
+    // The scene has a sphere over the background, slivers and an interpenetrating pair.
+    CHECK(a.layer_sums > 0);
+    CHECK(a.samples + a.front_layer > 0);
+  }
+  // The other modes count nothing.
+  CHECK(render(s, ModeKind::Aliased).stats.resolve_paths.total() == 0);
 }

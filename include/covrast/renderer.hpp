@@ -8,6 +8,7 @@
 #include <covrast/image.hpp>
 #include <covrast/options.hpp>
 #include <covrast/scene.hpp>
+#include <covrast/stats.hpp>
 
 #include <cstddef>
 #include <cstdint>
@@ -20,26 +21,6 @@ namespace covrast {
 
 /// True for the presets FxaaOptions::quality_preset accepts.
 bool valid_fxaa_preset(int quality_preset);
-
-struct RenderStats {
-  std::uint64_t triangles_in = 0;               ///< triangles submitted (after load-time drops)
-  std::uint64_t triangles_culled = 0;           ///< wholly outside the view volume, zero area, or
-                                                ///< a hidden back face (every dropped triangle)
-  std::uint64_t triangles_backface_culled = 0;  ///< of triangles_culled: hidden back faces
-  std::uint64_t triangles_clipped = 0;          ///< that needed clipping against a plane
-  std::uint64_t triangles_setup = 0;            ///< screen triangles that reached binning
-  std::uint64_t bin_entries = 0;                ///< (triangle, tile) pairs
-  std::uint64_t fragment_overflows = 0;  ///< coverage mode: fragments merged on list overflow
-  std::uint64_t scratch_bytes = 0;       ///< peak tile-local scratch over all threads
-  double setup_ms = 0;                   ///< transform, clip, snap, setup
-  double binning_ms = 0;
-  double raster_ms = 0;   ///< tile raster including per-tile resolve
-  double resolve_ms = 0;  ///< frame-level resolve (linear -> sRGB, copy-out)
-  double post_ms = 0;     ///< frame post-process (fxaa mode; 0 otherwise)
-  double render_ms = 0;   ///< the whole frame, without scene loading or PNG encoding
-  int threads = 0;
-  int tile = 0;
-};
 
 struct RenderResult {
   Image color;

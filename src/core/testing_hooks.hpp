@@ -49,13 +49,6 @@ struct CoverageHooks {
   /// to 2..kMaxFragmentsPerPixel; 0 = kMaxFragmentsPerPixel), so that small scenes reach the
   /// overflow policy.
   std::atomic<int> fragment_capacity{0};
-  /// Read once per tile: while it is on, each A-buffer tile adds to layer_resolves the number
-  /// of pixels it resolved from the one-layer sums. Off, a tile counts in a local only and
-  /// writes nothing shared.
-  std::atomic<bool> count_layer_resolves{false};
-  /// Pixels resolved from the one-layer sums while count_layer_resolves was on, over all
-  /// tiles and threads; a test sets it to 0 before the render it measures.
-  std::atomic<std::uint64_t> layer_resolves{0};
 };
 
 /// The coverage modes' hooks of this process, all off.

@@ -11,6 +11,7 @@
 #include "core/triangle_setup.hpp"
 
 #include <covrast/image.hpp>
+#include <covrast/stats.hpp>
 
 #include <cstdint>
 #include <memory>
@@ -34,6 +35,9 @@ class TileRasterizer {
   virtual std::size_t scratch_bytes() const = 0;
   /// Fragments merged or dropped because a pixel's list was full (coverage mode).
   virtual std::uint64_t overflow_count() const { return 0; }
+  /// Pixels per resolve path since the last call (coverage mode; zeros otherwise), and
+  /// starts counting again.
+  virtual CoverageResolvePaths take_resolve_paths() { return {}; }
   /// Time [ms] this instance has spent so far rasterising inside end_tile(): the banded
   /// sample modes record a large tile's triangles and replay them band by band there
   /// (sample_raster.cpp). The renderer counts it as raster time, not resolve time.

@@ -170,7 +170,10 @@ RenderResult Renderer::Impl::blank_result() const {
 std::uint64_t Renderer::Impl::begin_frame_counters() {
   for (auto& c : setup_counters) c = {};
   std::uint64_t overflows_before = 0;
-  for (const auto& r : rasterizers) overflows_before += r->overflow_count();
+  for (const auto& r : rasterizers) {
+    overflows_before += r->overflow_count();
+    r->take_resolve_paths();  // what an earlier frame left
+  }
   for (auto& r : resolve_thread_ms) r = 0;
   return overflows_before;
 }
@@ -255,6 +258,7 @@ void Renderer::Impl::fill_stats(RenderStats& st, std::uint64_t overflows_before,
   for (const auto& r : rasterizers) {
     st.scratch_bytes += r->scratch_bytes();
     st.fragment_overflows += r->overflow_count();
+    st.resolve_paths += r->take_resolve_paths();
   }
   st.fragment_overflows -= overflows_before;  // the counters run over the Renderer's life
   st.setup_ms = ms_between(t.setup, t.binning);

@@ -121,11 +121,17 @@ class ABufferTile {
   /// composited in depth order at the resolve (abuffer_transparency.cpp).
   void add_transparent(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                        double centre_z);
-  /// Resolves every pixel and writes the tile into the frame.
+  /// Resolves every pixel and writes the tile into the frame; counts each pixel's path.
   void resolve(const FrameTarget& target);
 
   std::size_t scratch_bytes() const;
   std::uint64_t overflow_count() const { return overflows_; }
+  /// Pixels per resolve path since the last call (resolve() counts every pixel once).
+  CoverageResolvePaths take_resolve_paths() {
+    const CoverageResolvePaths paths = paths_;
+    paths_ = {};
+    return paths;
+  }
 
  private:
   /// What the transparent fragments in front leave of each opaque contributor of a pixel
@@ -247,6 +253,12 @@ class ABufferTile {
   static bool shows_whole(int x, int y, const TriangleSetup* opaque, int n,
                           const TriangleSetup* const* tri, const MergedPiece* const* merged, int i,
                           int suspect);
+  /// resolve() without the check that every pixel was counted once.
+  void resolve_tile(const FrameTarget& target);
+  /// Whether no two fragments of the pixel's list (with `only` != 0: of those with that flag)
+  /// overlap, by the exact test on every pair of their triangles: the invariant of an open
+  /// set and of a one-layer pixel, checked by COVRAST_CHECK.
+  bool pairwise_disjoint(std::size_t pixel, std::uint32_t only) const;
   /// Writes the pixels `r` that show `opaque` (null: the background) alone into the frame.
   void resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
                             const FrameTarget& target);
@@ -344,6 +356,7 @@ class ABufferTile {
   std::vector<glm::vec3> color_;  ///< resolved linear colour
   std::vector<float> depth_;      ///< resolved window depth
   std::uint64_t overflows_ = 0;
+  CoverageResolvePaths paths_;  ///< pixels per resolve path (take_resolve_paths)
 };
 
 /// How plane `t` lies against plane `other` over pixel (x, y), from their depths at the

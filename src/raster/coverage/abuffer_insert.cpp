@@ -3,6 +3,7 @@
 // list is full.
 #include "raster/coverage/abuffer.hpp"
 
+#include "core/checks.hpp"
 #include "core/shading.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 
@@ -91,6 +92,9 @@ bool ABufferTile::hidden_by_container(std::size_t pixel, int x, int y,
 }
 
 void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
+  COVRAST_CHECK(layer_sums_[pixel].coverage >= std::uint32_t(kCoverageOne),
+                "a closed set's areas fill the pixel");
+  COVRAST_CHECK(pairwise_disjoint(pixel, kOpenFlag), "an open set's members are pairwise disjoint");
   occluder_z_[pixel] = std::min(occluder_z_[pixel], layer_sums_[pixel].far);
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     std::uint32_t& c = pool_[f].coverage;

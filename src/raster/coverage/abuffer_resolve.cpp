@@ -3,6 +3,7 @@
 // back on are in abuffer_visibility.cpp.
 #include "raster/coverage/abuffer.hpp"
 
+#include "core/checks.hpp"
 #include "core/shading.hpp"
 #include "core/srgb8.hpp"
 #include "core/testing_hooks.hpp"
@@ -160,7 +161,15 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   // Seen through transparent fragments: each opaque contributor times what they leave of it.
   if (tr != nullptr) behind *= float(tr->of(opaque));
   const auto keep = [tr](const TriangleSetup* t) { return tr != nullptr ? tr->of(t) : 1.0; };
-  if (head_[pixel] == kEnd) return behind;
+  // The path this pixel takes, counted for the opaque resolve (a transparent pixel is
+  // counted once, by resolve()).
+  const auto took = [&](std::uint64_t CoverageResolvePaths::*path) {
+    if (tr == nullptr) ++(paths_.*path);
+  };
+  if (head_[pixel] == kEnd) {
+    took(&CoverageResolvePaths::opaque);
+    return behind;
+  }
 
   const DepthRange opaque_range =
       opaque != nullptr ? depth_range(*opaque, x, y) : DepthRange{kFar, kFar};
@@ -201,7 +210,10 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     depth = std::min(depth, float(centre_z));
     ++n;
   }
-  if (n == 0) return behind;
+  if (n == 0) {
+    took(&CoverageResolvePaths::opaque);  // every fragment lies behind the opaque surface
+    return behind;
+  }
 
   const bool sums_allowed = !testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed);
   // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
@@ -220,6 +232,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     return front_layer_color(sums, behind);
   };
   if (sums_allowed && !crossing && pieces_disjoint(n, pieces, nullptr)) {
+    took(&CoverageResolvePaths::disjoint);
     return layer_color(nullptr);
   }
 
@@ -241,6 +254,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   if (sums_allowed && front_separate &&
       (front.members == n || front.coverage >= std::uint32_t(kCoverageOne)) &&
       pieces_disjoint(n, pieces, in_front)) {
+    took(&CoverageResolvePaths::front_layer);
     return layer_color(in_front);
   }
   double weight[kMaxFragmentsPerPixel];
@@ -249,14 +263,20 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   const double share =
       n == 1 && crossing && merged[0] == nullptr ? visible_share(*tri[0], *opaque, x, y) : -1.0;
   if (share >= 0.0) {
+    took(&CoverageResolvePaths::clipped);
     weight[0] = double(cov[0]) / kCoverageOne * share;
   } else {
+    took(&CoverageResolvePaths::samples);
     bool estimated[kMaxFragmentsPerPixel];
     const int behind_samples = sample_weights(x, y, opaque, n, tri, cov, merged, weight, estimated);
     fill_estimated_share(n, cov, estimated, double(behind_samples) / kMaskSamples, weight);
   }
   double total = 0;
-  for (int i = 0; i < n; ++i) total += weight[i];
+  for (int i = 0; i < n; ++i) {
+    COVRAST_CHECK(weight[i] >= 0.0 && weight[i] <= double(cov[i]) / kCoverageOne * (1.0 + 1e-9),
+                  "a fragment's visible weight lies between 0 and its exact area");
+    total += weight[i];
+  }
   const double scale = total > 1.0 ? 1.0 / total : 1.0;
   const double rest = total > 1.0 ? 0.0 : 1.0 - total;
   double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
@@ -305,15 +325,43 @@ void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelR
   write_tile(target, r, color_.data() + first, depth_.data() + first, stride_);
 }
 
+bool ABufferTile::pairwise_disjoint(std::size_t pixel, std::uint32_t only) const {
+  auto member = [&](std::uint32_t f) { return only == 0 || (pool_[f].coverage & only) != 0; };
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if (!member(f)) continue;
+    const TriangleSetup* const* a;
+    const int na = fragment_pieces(f, a);
+    for (std::uint32_t g = pool_[f].next; g != kEnd; g = pool_[g].next) {
+      if (!member(g)) continue;
+      const TriangleSetup* const* b;
+      const int nb = fragment_pieces(g, b);
+      for (int i = 0; i < na; ++i) {
+        for (int k = 0; k < nb; ++k) {
+          if (!interiors_disjoint(*a[i], *b[k])) return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
 void ABufferTile::resolve(const FrameTarget& target) {
+  [[maybe_unused]] const std::uint64_t counted_before = paths_.total();
+  resolve_tile(target);
+  COVRAST_CHECK(paths_.total() - counted_before ==
+                    std::uint64_t(rect_.x1 - rect_.x0) * std::uint64_t(rect_.y1 - rect_.y0),
+                "every pixel of a tile takes exactly one resolve path");
+}
+
+void ABufferTile::resolve_tile(const FrameTarget& target) {
   if (tile_uniform_) {
+    paths_.uniform_tile += std::uint64_t(rect_.x1 - rect_.x0) * std::uint64_t(rect_.y1 - rect_.y0);
     resolve_opaque_block(uniform_, rect_, target);
     return;
   }
   testing::CoverageHooks& hooks = testing::coverage_hooks;
   const bool use_sums = !hooks.list_resolve.load(std::memory_order_relaxed) &&
                         !hooks.mask_resolve.load(std::memory_order_relaxed);
-  std::uint64_t from_sums = 0;
   const int block_cols = (rect_.x1 - rect_.x0 + kBlockPx - 1) / kBlockPx;
   const int block_rows = (rect_.y1 - rect_.y0 + kBlockPx - 1) / kBlockPx;
   for (int by = 0; by < block_rows; ++by) {
@@ -321,6 +369,7 @@ void ABufferTile::resolve(const FrameTarget& target) {
       const std::size_t block = std::size_t(by) * block_stride_ + bx;
       const PixelRect br = block_rect(block);
       if (block_uniform_[block]) {
+        paths_.uniform_block += std::uint64_t(br.x1 - br.x0) * std::uint64_t(br.y1 - br.y0);
         resolve_opaque_block(block_opaque_[block], br, target);
         continue;
       }
@@ -330,23 +379,28 @@ void ABufferTile::resolve(const FrameTarget& target) {
           if (any_transparent_ && transparent_head_[pixel] != kEnd) {
             // Transparent fragments: none of the one-layer shortcuts (they assume nothing
             // in front of the opaque resolve).
+            ++paths_.transparent;
             color_[pixel] =
                 resolve_transparent(pixel, x, y, target.background_linear, depth_[pixel]);
             continue;
           }
           if (use_sums && layer_[pixel] == Layer::One && opaque_[pixel] == nullptr) {
             // One layer over the background: what resolve_pixel's first branch gives.
+            COVRAST_CHECK(pairwise_disjoint(pixel, 0),
+                          "a one-layer pixel's fragments are pairwise disjoint");
             const LayerSums& sums = layer_sums_[pixel];
             color_[pixel] = front_layer_color(sums, target.background_linear);
             depth_[pixel] = sums.depth;
-            ++from_sums;
+            ++paths_.layer_sums;
             continue;
           }
           if (layer_[pixel] == Layer::Sampled) {
+            ++paths_.overflowed;
             color_[pixel] = resolve_samples(pixel, x, y, target.background_linear, depth_[pixel]);
             continue;
           }
           if (head_[pixel] == kEnd) {
+            ++paths_.opaque;
             // No fragments: the opaque surface or the background, as resolve_pixel gives it.
             color_[pixel] =
                 opaque_pixel(opaque_[pixel], x, y, target.background_linear, depth_[pixel]);
@@ -358,9 +412,6 @@ void ABufferTile::resolve(const FrameTarget& target) {
       const std::size_t first = std::size_t(br.y0 - rect_.y0) * stride_ + (br.x0 - rect_.x0);
       write_tile(target, br, color_.data() + first, depth_.data() + first, stride_);
     }
-  }
-  if (hooks.count_layer_resolves.load(std::memory_order_relaxed)) {
-    hooks.layer_resolves.fetch_add(from_sums, std::memory_order_relaxed);
   }
 }
 }  // namespace covrast::detail

@@ -101,6 +101,7 @@ class CoverageRasterizer final : public TileRasterizer {
            depth_.size() * sizeof(float) + abuffer_.scratch_bytes();
   }
   std::uint64_t overflow_count() const override { return abuffer_.overflow_count(); }
+  CoverageResolvePaths take_resolve_paths() override { return abuffer_.take_resolve_paths(); }
 
  private:
   /// Hands the group's covered pixels (rows [first, end), columns [g, g + lanes)) on.
