@@ -90,15 +90,6 @@ void bin_impl(const TileGrid& grid, std::uint32_t count, BoundsOf bounds_of, Chu
 
 }  // namespace
 
-void bin_chunk(const TileGrid& grid, std::span<const TriangleSetup> triangles, ChunkBins& bins,
-               std::vector<std::uint32_t>& scratch) {
-  const PixelRect image{0, 0, grid.width_px, grid.height_px};
-  bin_impl(
-      grid, std::uint32_t(triangles.size()),
-      [&](std::uint32_t i) { return intersect(touched_pixels(triangles[i]), image); }, bins,
-      scratch);
-}
-
 void bin_chunk(const TileGrid& grid, std::span<const PixelBounds16> bounds, ChunkBins& bins,
                std::vector<std::uint32_t>& scratch) {
   bin_impl(

@@ -48,12 +48,9 @@ struct ChunkBins {
   }
 };
 
-/// Bins one chunk. `scratch` is reused between calls to avoid allocation.
-void bin_chunk(const TileGrid& grid, std::span<const TriangleSetup> triangles, ChunkBins& bins,
-               std::vector<std::uint32_t>& scratch);
-
 /// Bins one chunk from the clamped pixel bounds that setup stored next to its triangles
-/// (bounds[i] belongs to triangle i): the same bins as above, without reading the setups.
+/// (bounds[i] belongs to triangle i), without reading the setups. `scratch` is reused between
+/// calls to avoid allocation.
 void bin_chunk(const TileGrid& grid, std::span<const PixelBounds16> bounds, ChunkBins& bins,
                std::vector<std::uint32_t>& scratch);
 

@@ -129,6 +129,18 @@ inline bool inner_point(const ClipPolygon& poly, double& px, double& py) {
   return true;
 }
 
+/// Whether point (px, py) [pixels] lies in `t`, edges included, in double from the snapped
+/// vertices: the one-point visibility test of fragments too thin to own a sample.
+inline bool covers_point(const TriangleSetup& t, double px, double py) {
+  const double s = 1.0 / kSubpixelOne;
+  for (int i = 0; i < 3; ++i) {
+    const int j = i == 2 ? 0 : i + 1;
+    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
+    if ((t.x_fx8[j] * s - xi) * (py - yi) - (t.y_fx8[j] * s - yi) * (px - xi) < 0.0) return false;
+  }
+  return true;
+}
+
 /// A triangle's plane at the samples of one pixel: z(k) = z0 + dz/dx * x(k) + dz/dy * y(k),
 /// z0 its depth at the pixel's corner, (x(k), y(k)) sample k's offset. Every comparison of
 /// sample_weights uses this expression (no contraction: -ffp-contract=off), so its results

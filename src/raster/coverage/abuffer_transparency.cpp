@@ -29,19 +29,6 @@
 namespace covrast::detail {
 namespace {
 
-/// Whether point (px, py) lies in `t` (closed: edges count), in double from the snapped
-/// vertices; for the one-point test of slivers.
-bool contains(const TriangleSetup& t, double px, double py) {
-  const double s = 1.0 / kSubpixelOne;
-  for (int i = 0; i < 3; ++i) {
-    const int j = (i + 1) % 3;
-    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
-    const double e = (t.x_fx8[j] * s - xi) * (py - yi) - (t.y_fx8[j] * s - yi) * (px - xi);
-    if (e < 0.0) return false;
-  }
-  return true;
-}
-
 /// One transparent fragment of the pixel being resolved.
 struct Clear {
   const TriangleSetup* t;
@@ -239,7 +226,7 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
     const double zj = c.t->depth_at(px, py);
     bool visible = true;
     for (int s = 0; s < tr.n && visible; ++s) {
-      if (tr.who[s] != nullptr && contains(*tr.who[s], px, py)) {
+      if (tr.who[s] != nullptr && covers_point(*tr.who[s], px, py)) {
         visible = !(tr.who[s]->depth_at(px, py) <= zj);
       }
     }
@@ -249,7 +236,7 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
     }
     double t = 1.0;
     for (int i = 0; i < n && visible; ++i) {
-      if (i == j || !contains(*clear[i].t, px, py)) continue;
+      if (i == j || !covers_point(*clear[i].t, px, py)) continue;
       if (nearer(clear[i].t->depth_at(px, py), *clear[i].t, zj, *c.t)) t *= 1.0 - clear[i].alpha;
     }
     c.shown = visible ? t : 0.0;

@@ -28,17 +28,6 @@ int lost_to(const SampleMask& mine, const std::uint8_t* best, int i) {
   return -1;
 }
 
-/// Whether point p [pixels] lies inside or on the edges of `t`.
-bool covers_point(const TriangleSetup& t, double px, double py) {
-  const double s = 1.0 / kSubpixelOne;
-  for (int i = 0; i < 3; ++i) {
-    const int j = i == 2 ? 0 : i + 1;
-    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
-    if ((t.x_fx8[j] * s - xi) * (py - yi) - (t.y_fx8[j] * s - yi) * (px - xi) < 0.0) return false;
-  }
-  return true;
-}
-
 /// Whether fragment i is the nearest at point p of its part of the pixel among the fragments
 /// that cover p (nearer, or level and earlier, than each). Samples cannot tell it for a
 /// fragment too thin to own one: two such slivers folded over one another along a shared
