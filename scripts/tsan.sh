@@ -13,8 +13,7 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 build=${1:-build/tsan}
 # The suppressions name functions, so reports must be symbolized: without llvm-symbolizer
-# every frame is <null>, nothing matches, and oneTBB's bookkeeping shows up as races. The
-# runtime checks the tool's file name, and llvm-symbolizer is the name it knows.
+# every frame is <null>, nothing matches, and oneTBB's bookkeeping shows up as races.
 symbolizer=
 for candidate in /usr/lib/llvm-14/bin/llvm-symbolizer "$(command -v llvm-symbolizer || true)"; do
   if [[ -n "$candidate" && -x "$candidate" ]]; then
