@@ -293,7 +293,7 @@ TEST_CASE("cli: --threads above the hardware threads prints nothing from the sch
   CHECK(nlohmann::json::parse(r.out).at("threads") == threads);
 }
 
-TEST_CASE("cli: scene warnings go to stderr; --strict makes them errors", "[cli]") {
+TEST_CASE("cli: scene warnings go to stderr, --strict makes them errors", "[cli]") {
   TempDir dir;
   // The second triangle has an infinite coordinate (1e400 overflows): dropped with a warning.
   write_text(dir / "inf.obj", std::string(kTriangleObj) + "v 1e400 0 0\nf 1 2 4\n");
