@@ -175,6 +175,7 @@ in_root() { # COMMAND: runs a shell command in /root/covrast in the root, with a
     bash -c "cd /root/covrast && $1"
 }
 
+# shellcheck disable=SC2016 # expanded in the root
 timed "bash scripts/render-default.sh" in_root 'png=$(bash scripts/render-default.sh) && test -s "$png" && echo "rendered $png"'
 if [[ $render_only -eq 0 ]]; then
   timed "bash scripts/test.sh" in_root 'bash scripts/test.sh'

@@ -34,7 +34,7 @@ aarch64_packages=(
 )
 
 # Usage: scripts/setup.sh [--list] [--build-only | --aarch64]
-set_name=test
+set_name="test"
 list=0
 for arg in "$@"; do
   case "$arg" in
