@@ -2,7 +2,9 @@
 # Installs the Debian packages covrast needs to build and test (Debian 12); with --build-only,
 # just what building the executable needs (no clang); with --aarch64, what cross-building for
 # 64-bit ARM and running it under emulation needs (scripts/check-aarch64.sh): the arm64
-# architecture is added to dpkg first if it is missing. Idempotent: asks
+# architecture is added to dpkg first if it is missing. With --list, prints the packages of the
+# chosen set on one line, space-separated, and installs nothing (CI images and docs/ci.md
+# install from it). Idempotent: asks
 # dpkg-query which packages are missing and installs only those; when none is missing it does
 # not call apt-get at all. Runs as root (the CI case) or through sudo when available.
 set -euo pipefail
@@ -17,8 +19,10 @@ build_packages=(
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for
 # the scene and report scripts, chromium to load covrast test's HTML report headless.
 # libclang-rt-14-dev holds libFuzzer and the sanitizer runtimes (the fuzz, asan, ubsan and
-# tsan presets).
-test_packages=(clang libclang-rt-14-dev python3 chromium)
+# tsan presets); llvm-14 holds llvm-symbolizer, without which sanitizer reports have no
+# function names and tests/tsan.supp (which matches function names) matches nothing
+# (clang-14 only recommends it, and recommendations are not installed here).
+test_packages=(clang libclang-rt-14-dev llvm-14 python3 chromium)
 # Cross-building for aarch64: the cross compiler, the emulator, `file` (the script checks the
 # executable's architecture) and the arm64 builds of every library with compiled code or an
 # architecture-specific package (the header-only glm, nlohmann-json and CLI11 are
@@ -29,13 +33,30 @@ aarch64_packages=(
   libtinyobjloader-dev:arm64 libtinygltf-dev:arm64 libturbojpeg0-dev:arm64
 )
 
-# Usage: scripts/setup.sh [--build-only | --aarch64]
+# Usage: scripts/setup.sh [--list] [--build-only | --aarch64]
+set_name="test"
+list=0
+for arg in "$@"; do
+  case "$arg" in
+    --build-only) set_name=build ;;
+    --aarch64) set_name=aarch64 ;;
+    --list) list=1 ;;
+    *)
+      echo "setup: error: unknown argument '$arg' (usage: scripts/setup.sh [--list] [--build-only | --aarch64])" >&2
+      exit 2
+      ;;
+  esac
+done
 packages=("${build_packages[@]}")
-case "${1:-}" in
-  --build-only) ;;
-  --aarch64) packages+=("${aarch64_packages[@]}") ;;
-  *) packages+=("${test_packages[@]}") ;;
+case "$set_name" in
+  build) ;;
+  aarch64) packages+=("${aarch64_packages[@]}") ;;
+  test) packages+=("${test_packages[@]}") ;;
 esac
+if [[ $list -eq 1 ]]; then
+  echo "${packages[*]}"
+  exit 0
+fi
 
 missing=()
 for package in "${packages[@]}"; do
@@ -61,7 +82,7 @@ else
 fi
 
 echo "setup: installing ${missing[*]}"
-if [[ "${1:-}" == --aarch64 ]] && ! dpkg --print-foreign-architectures | grep -qx arm64; then
+if [[ "$set_name" == aarch64 ]] && ! dpkg --print-foreign-architectures | grep -qx arm64; then
   echo "setup: adding the arm64 architecture to dpkg"
   "${as_root[@]}" dpkg --add-architecture arm64
 fi

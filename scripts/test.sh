@@ -26,12 +26,12 @@ step "ctest $preset" ctest --preset "$preset"
 
 # ASan + UBSan: one clang build (-O1, -Werror, everything) serves the whole suite, the fuzz
 # targets and the comparison with g++. Sanitizer builds do not register the tests tagged
-# [sanitizer-slow]; the black-box report, Chromium and install tests ran above
+# [sanitizer-slow]; the black-box report, Chromium, install and documentation tests ran above
 # (docs/testing.md says which and why).
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 step "build fuzz (clang, ASan+UBSan)" bash scripts/build.sh fuzz
-step "ctest fuzz (ASan+UBSan)" ctest --preset fuzz -E '^(report_quick|report_in_chromium|install_consumer)$'
+step "ctest fuzz (ASan+UBSan)" ctest --preset fuzz -E '^(report_quick|report_in_chromium|install_consumer|docs_examples)$'
 step "g++ vs clang" bash scripts/check-compilers.sh --clang-build build/fuzz "build/$preset/covrast"
 step "fuzz targets, 10 s each" bash scripts/fuzz.sh --no-build 10
 

@@ -12,7 +12,22 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 build=${1:-build/tsan}
-export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp"
+# The suppressions name functions, so reports must be symbolized: without llvm-symbolizer
+# every frame is <null>, nothing matches, and oneTBB's bookkeeping shows up as races.
+symbolizer=
+for candidate in /usr/lib/llvm-14/bin/llvm-symbolizer "$(command -v llvm-symbolizer || true)"; do
+  if [[ -n "$candidate" && -x "$candidate" ]]; then
+    symbolizer=$candidate
+    break
+  fi
+done
+if [[ -z "$symbolizer" ]]; then
+  echo "tsan: error: llvm-symbolizer not found (Debian package llvm-14, which scripts/setup.sh" \
+    "installs): without it TSan's reports have no function names and tests/tsan.supp matches" \
+    "nothing" >&2
+  exit 1
+fi
+export TSAN_OPTIONS="halt_on_error=1:second_deadlock_stack=1:suppressions=$PWD/tests/tsan.supp:external_symbolizer_path=$symbolizer"
 
 # The canary first: the same suppressions must pass ordered hand-offs and catch a real race.
 "$build/tests/tsan_canary" ordered

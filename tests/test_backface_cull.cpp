@@ -250,7 +250,7 @@ TEST_CASE("analysis: open, non-manifold and mixed meshes are not closed", "[cull
   }
 }
 
-TEST_CASE("analysis: degenerate triangles are ignored; separate cubes and spheres are closed",
+TEST_CASE("analysis: degenerate triangles are ignored, separate cubes and spheres are closed",
           "[cull]") {
   SECTION("a cube plus triangles with two equal (welded) vertices") {
     auto m = cube();

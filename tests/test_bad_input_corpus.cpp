@@ -57,7 +57,7 @@ struct Case {
   /// would block until a writer comes).
   std::string fifo;
   /// With --strict: the start of the warning (after "warning: ") that must be printed
-  /// before the error line.
+  /// after the error line.
   std::string warning;
 };
 
@@ -277,15 +277,15 @@ TEST_CASE("bad-input corpus: each malformed input gives its exit code and messag
     const covrast::test::RunResult r = run_in(dir, c.args);
     INFO("stderr: " << r.err);
     CHECK(r.exit_code == c.exit_code);
-    // One error line, the last; before it only warnings (with --strict).
+    // One error line, the first; after it only warnings (with --strict).
     std::vector<std::string> lines;
     std::istringstream stream(r.err);
     for (std::string line; std::getline(stream, line);) lines.push_back(line);
     REQUIRE(!lines.empty());
     const std::string expected = "covrast: error: " + c.message;
-    CHECK(lines.back().compare(0, expected.size(), expected) == 0);
+    CHECK(lines.front().compare(0, expected.size(), expected) == 0);
     bool warned = c.warning.empty();
-    for (std::size_t i = 0; i + 1 < lines.size(); ++i) {
+    for (std::size_t i = 1; i < lines.size(); ++i) {
       CHECK(lines[i].rfind("warning: ", 0) == 0);
       warned = warned || lines[i].rfind("warning: " + c.warning, 0) == 0;
     }

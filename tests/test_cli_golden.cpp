@@ -114,7 +114,7 @@ TEST_CASE("covrast test: a changed golden fails with its measures and reports", 
       w.run({"m.json", "--junit", "r.xml", "--artifacts", "art", "--report", "rep"});
   INFO(r.out << r.err);
   CHECK(r.exit_code == 1);
-  CHECK(r.out.find("FAIL tri: max_diff 40 > 0") != std::string::npos);
+  CHECK(r.out.find("FAIL tri: diff 40 > 0") != std::string::npos);
   CHECK(r.out.find("golden: (no record") != std::string::npos);
   CHECK(r.out.find("2 passed, 1 failed, 1 skipped") != std::string::npos);
   // Artifacts of the failing case only: its render and the heat map of the difference.
@@ -129,7 +129,7 @@ TEST_CASE("covrast test: a changed golden fails with its measures and reports", 
   CHECK(xml.find("<testsuite name=\"m\" tests=\"4\" failures=\"1\" errors=\"0\" skipped=\"1\"") !=
         std::string::npos);
   CHECK(xml.find("<testcase name=\"tri\" classname=\"m\"") != std::string::npos);
-  CHECK(xml.find("<failure message=\"max_diff 40 &gt; 0") != std::string::npos);
+  CHECK(xml.find("<failure message=\"diff 40 &gt; 0") != std::string::npos);
   CHECK(xml.find("<skipped message=\"not yet\"/>") != std::string::npos);
   // The report: one page, images inline, no external resources.
   const std::string html = read_text(w / "rep/index.html");
@@ -153,8 +153,8 @@ TEST_CASE("covrast test: tolerances, JSON summary, --shard and --filter", "[cli]
     CHECK(j["failed"] == 1);
     REQUIRE(j["cases"].size() == 1);
     CHECK(j["cases"][0]["name"] == "quad");
-    CHECK(j["cases"][0]["max_diff"] == 1);
-    CHECK(j["cases"][0]["share_over_1"] == 0.0);  // 1/255 is not over 1/255
+    CHECK(j["cases"][0]["diff"] == 1);
+    CHECK(j["cases"][0]["pixels"] == 0.0);  // 1/255 is not over 1/255
   }
   SECTION("within a tolerance") {
     std::string m = kManifest;

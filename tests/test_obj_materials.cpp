@@ -221,7 +221,7 @@ TEST_CASE("OBJ materials: one Kd is the uniform colour, unlit and lit alike", "[
   CHECK(b.rgb != a.rgb);
 }
 
-TEST_CASE("OBJ: a missing .mtl and unknown names are warnings; --strict fails", "[obj][mtl]") {
+TEST_CASE("OBJ: a missing .mtl and unknown names are warnings, --strict fails", "[obj][mtl]") {
   TempDir dir;
   dir.write("a.obj", "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl x\nf 1 2 3\n");
   dir.write("scene.json", scene_of("a.obj").dump());
@@ -337,7 +337,7 @@ TEST_CASE("a concave OBJ polygon renders only its own pixels", "[obj][polygon]")
   CHECK(int(image.pixel(px(-0.5), 31 - px(0.4))[0]) == 255);  // its left arm
 }
 
-TEST_CASE("degenerate OBJ polygons fall back to the fan with a warning; l and p counted",
+TEST_CASE("degenerate OBJ polygons fall back to the fan with a warning, l and p counted",
           "[obj][polygon]") {
   TempDir dir;
   // A bow tie (self-intersecting, zero Newell normal) and four corners on one line.
@@ -356,7 +356,7 @@ TEST_CASE("degenerate OBJ polygons fall back to the fan with a warning; l and p 
             obj + ": 2 line (l) and 1 point (p) statements not drawn: covrast draws faces only"});
 }
 
-TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file; missing is an error",
+TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file, missing is an error",
           "[obj][mtl][textures]") {
   TempDir dir;
   dir.write("quad.mtl", "newmtl a\nKd 1 1 1\nmap_Kd tex.png\nnewmtl b\nKd 1 1 1\nmap_Kd tex.png\n");

@@ -191,7 +191,7 @@ TEST_CASE("sphere.obj is a closed, consistently and outwards wound unit sphere",
   CHECK(volume > 0.98 * ball_volume);
 }
 
-TEST_CASE("box.obj is a closed outwards-wound unit cube; fan.obj is an open soup", "[scenegen]") {
+TEST_CASE("box.obj is a closed outwards-wound unit cube, fan.obj is an open soup", "[scenegen]") {
   const ObjMesh box = parse_obj(kScenesDir / "box.obj");
   CHECK(box.triangles.size() == 12);
   CHECK(is_closed_and_consistently_wound(box));

@@ -271,7 +271,7 @@ std::unique_ptr<SampleRasterizer> ssaa_raster(int tile_px, int n, bool grid) {
 // ---------------------------------------------------------------------------------------
 
 TEST_CASE(
-    "ssaa-cmj patterns are n-rooks on the 1/256 grid; ssaa and ssaa-grid are the ordered grid",
+    "ssaa-cmj patterns are n-rooks on the 1/256 grid, ssaa and ssaa-grid are the ordered grid",
     "[ssaa]") {
   for (int n = 1; n <= 16; ++n) {
     // ssaa:N uses the ordered grid (docs/supersampling.md says why).

@@ -740,7 +740,7 @@ TEST_CASE("textures: occlusion, emissive and normal textures in a lit scene", "[
           }) == encoded(n.x));
 }
 
-TEST_CASE("textures: TEXCOORD as normalized integers; a missing UV set is a warning",
+TEST_CASE("textures: TEXCOORD as normalized integers, a missing UV set is a warning",
           "[textures]") {
   covrast::test::TempDir dir("covrast-textures");
   write_file(dir / "t.png", png_bytes(2, 2, 90));

@@ -2,6 +2,8 @@
 // plus the helpers they share. Uses only the public headers in include/covrast/.
 #pragma once
 
+#include <covrast/error.hpp>
+
 #include <CLI/CLI.hpp>
 
 #include <filesystem>
@@ -61,6 +63,18 @@ struct TestArgs {
   int threads = 0;
   bool strict = false;
   bool quiet = false;
+};
+
+/// The error of `--strict` on a scene with warnings: one line, printed first like every error;
+/// main() prints the warnings after it, one `warning: ...` line each.
+class StrictWarningsError : public InputError {
+ public:
+  StrictWarningsError(const std::string& message, std::vector<std::string> warnings)
+      : InputError(message), warnings_(std::move(warnings)) {}
+  const std::vector<std::string>& warnings() const { return warnings_; }
+
+ private:
+  std::vector<std::string> warnings_;
 };
 
 CLI::App* add_render_command(CLI::App& app, RenderArgs& args);

@@ -1,6 +1,9 @@
 // `covrast compare`: compares two PNGs (RMSE in linear light, PSNR, largest 8-bit difference,
 // shares of differing pixels), optionally writes a difference heat map, and checks optional
 // thresholds for golden-image tests: exit 0 when all hold, 1 when any is exceeded.
+// One vocabulary with `covrast test` and its manifests: the three measures are `rmse`,
+// `diff` (largest channel difference) and `pixels` (share of pixels off by more than 1/255),
+// and `--max-X` (a manifest's tolerance `max_X`) bounds measure X.
 #include "commands.hpp"
 
 #include <covrast/compare.hpp>
@@ -19,7 +22,8 @@ CLI::App* add_compare_command(CLI::App& app, CompareArgs& args) {
       "Compare two PNG images of the same size: RMSE (linear light), PSNR, largest channel "
       "difference (8-bit sRGB) and the shares of pixels off by more than 1/255 and 8/255. "
       "With thresholds, prints 'FAIL: <measure> <value> > <limit>' to stderr for each one "
-      "exceeded and exits 1; exits 0 when all hold.");
+      "exceeded (measures rmse, diff, pixels: what --max-rmse, --max-diff and --max-pixels "
+      "bound) and exits 1; exits 0 when all hold.");
   sub->add_option("A", args.image_a, "First image (PNG)")->required()->type_name("PNG");
   sub->add_option("B", args.image_b, "Second image (PNG)")->required()->type_name("PNG");
   sub->add_option("--heatmap", args.heatmap,
@@ -62,10 +66,10 @@ int run_compare(const CompareArgs& args) {
     std::cout << "size:        " << result.width << "x" << result.height << '\n'
               << "rmse:        " << format_number(result.rmse_linear) << " (linear)\n"
               << "psnr:        " << format_number(result.psnr_db) << " dB\n"
-              << "max diff:    " << result.max_diff_srgb8 << "/255\n"
-              << "over 1/255:  " << percent(result.pixels_over_1) << " of pixels ("
+              << "diff:        " << result.max_diff_srgb8 << "/255 (largest channel difference)\n"
+              << "pixels:      " << percent(result.pixels_over_1) << " off by more than 1/255 ("
               << result.pixels_over_1 << ")\n"
-              << "over 8/255:  " << percent(result.pixels_over_8) << " of pixels ("
+              << "             " << percent(result.pixels_over_8) << " off by more than 8/255 ("
               << result.pixels_over_8 << ")\n";
   }
 
@@ -81,11 +85,11 @@ int run_compare(const CompareArgs& args) {
                        format_number(*args.max_rmse));
   }
   if (args.max_diff && result.max_diff_srgb8 > *args.max_diff) {
-    failures.push_back("max_diff " + std::to_string(result.max_diff_srgb8) + " > " +
+    failures.push_back("diff " + std::to_string(result.max_diff_srgb8) + " > " +
                        std::to_string(*args.max_diff));
   }
   if (args.max_pixels && result.share_over_1 > *args.max_pixels) {
-    failures.push_back("share_over_1 " + format_number(result.share_over_1) + " > " +
+    failures.push_back("pixels " + format_number(result.share_over_1) + " > " +
                        format_number(*args.max_pixels));
   }
   for (const std::string& failure : failures) std::cerr << "FAIL: " << failure << '\n';

@@ -136,8 +136,8 @@ void html_failure(std::ostringstream& html, const CaseResult& r) {
 }
 
 void html_table(std::ostringstream& html, const std::vector<CaseResult>& results) {
-  html << "<h2>All cases</h2>\n<table><tr><th>case</th><th>status</th><th>max diff</th>"
-          "<th>pixels over 1/255</th><th>RMSE</th><th>render ms</th></tr>\n";
+  html << "<h2>All cases</h2>\n<table><tr><th>case</th><th>status</th><th>diff</th>"
+          "<th>pixels</th><th>rmse</th><th>render ms</th></tr>\n";
   for (const CaseResult& r : results) {
     const bool compared = r.measures.width > 0;
     html << "<tr><td>" << escaped(r.test->name) << "</td><td class=\""
@@ -204,8 +204,8 @@ std::string summary_json(const std::vector<CaseResult>& results, const RunSummar
     c["name"] = r.test->name;
     c["status"] = status_name(r.status);
     if (r.measures.width > 0) {
-      c["max_diff"] = r.measures.max_diff_srgb8;
-      c["share_over_1"] = r.measures.share_over_1;
+      c["diff"] = r.measures.max_diff_srgb8;
+      c["pixels"] = r.measures.share_over_1;
       c["rmse"] = r.measures.rmse_linear;
     }
     if (!r.exceeded.empty()) c["failure"] = failure_text(r);

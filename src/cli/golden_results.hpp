@@ -18,7 +18,7 @@ struct CaseResult {
   const TestCase* test = nullptr;
   CaseStatus status = CaseStatus::Skipped;
   CompareResult measures;             ///< when a golden was compared
-  std::vector<std::string> exceeded;  ///< e.g. "max_diff 3 > 0"; or why it failed
+  std::vector<std::string> exceeded;  ///< e.g. "diff 3 > 0"; or why it failed
   std::string golden_record;          ///< what rendered the golden (its PNG text), if known
   std::string actual_record;          ///< what rendered this run
   double render_ms = 0;
@@ -34,7 +34,7 @@ struct RunSummary {
 };
 
 const char* status_name(CaseStatus status);
-/// "max_diff 3 > 0, rmse 0.0012 > 0" or the reason a case failed.
+/// "diff 3 > 0, rmse 0.0012 > 0" or the reason a case failed.
 std::string failure_text(const CaseResult& result);
 
 /// JUnit XML: one testsuite, one testcase per case (name = the case's name), a <failure>

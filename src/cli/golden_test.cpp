@@ -133,15 +133,13 @@ class Progress {
 std::vector<std::string> exceeded_measures(const CompareResult& r, const Tolerance& t) {
   std::vector<std::string> out;
   if (r.max_diff_srgb8 > t.max_diff) {
-    out.push_back("max_diff " + std::to_string(r.max_diff_srgb8) + " > " +
-                  std::to_string(t.max_diff));
+    out.push_back("diff " + std::to_string(r.max_diff_srgb8) + " > " + std::to_string(t.max_diff));
   }
   if (r.share_over_1 > t.max_pixels) {
-    out.push_back("max_pixels " + format_number(r.share_over_1) + " > " +
-                  format_number(t.max_pixels));
+    out.push_back("pixels " + format_number(r.share_over_1) + " > " + format_number(t.max_pixels));
   }
   if (r.rmse_linear > t.max_rmse) {
-    out.push_back("max_rmse " + format_number(r.rmse_linear) + " > " + format_number(t.max_rmse));
+    out.push_back("rmse " + format_number(r.rmse_linear) + " > " + format_number(t.max_rmse));
   }
   return out;
 }

@@ -77,6 +77,10 @@ int main(int argc, char** argv) {
     if (test->parsed()) return covrast::cli::run_test(test_args);
     print_error("no subcommand given (run 'covrast --help' for usage)");
     return 2;
+  } catch (const covrast::cli::StrictWarningsError& e) {
+    print_error(e.what());  // the error line first, then the warnings it is about
+    for (const std::string& warning : e.warnings()) std::cerr << "warning: " << warning << '\n';
+    return 2;
   } catch (const covrast::InputError& e) {
     print_error(e.what());
     return 2;

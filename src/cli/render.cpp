@@ -188,11 +188,15 @@ int run_render(const RenderArgs& args) {
                           ? load_mesh_scene(args.scene, options.width > 0 ? options.width : 640,
                                             options.height > 0 ? options.height : 360)
                           : load_scene(args.scene);
-  for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
   if (args.strict && !scene.warnings.empty()) {
-    throw InputError(args.scene + ": " + std::to_string(scene.warnings.size()) +
-                     " warning(s), and --strict treats warnings as errors");
+    // The error line first (main prints the warnings after it).
+    const std::size_t count = scene.warnings.size();
+    throw StrictWarningsError(
+        args.scene + ": --strict treats warnings as errors: " + scene.warnings.front() +
+            (count > 1 ? " (" + std::to_string(count) + " warnings below)" : ""),
+        scene.warnings);
   }
+  for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
 
   Renderer renderer(scene, options);
   const bool show_progress = args.repeat > 1 && ::isatty(STDERR_FILENO) == 1;
