@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 namespace covrast::detail {
 namespace {
@@ -85,6 +86,19 @@ double read_component(const unsigned char* bytes, int component_type, bool norma
 
 void fail(const std::string& name, const std::string& message) {
   throw InputError(name + ": " + message);
+}
+
+std::optional<int> whole_number(const tinygltf::Value& value, int lo, int hi) {
+  if (!value.IsNumber()) return std::nullopt;
+  const double x = value.GetNumberAsDouble();
+  if (!(x >= double(lo) && x <= double(hi)) || std::floor(x) != x) return std::nullopt;
+  return static_cast<int>(x);
+}
+
+std::string number_text(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
 }
 
 /// `text` with every byte outside printable ASCII shown as '?' (messages are one line).

@@ -481,7 +481,38 @@ class GltfMeshBuilder {
         fail(name_, what + ": JOINTS" + suffix + " and WEIGHTS" + suffix +
                         " must both be VEC4 with one value per vertex");
       }
+      check_skin_component_types(source.primitive, suffix, what);
       sets.push_back({std::move(*joints), std::move(*weights)});
+    }
+  }
+
+  /// glTF 2.0, 3.7.3.3: JOINTS_n are unsigned bytes or shorts, WEIGHTS_n floats or normalized
+  /// unsigned bytes or shorts. Any other type (a float or signed joint number) is an error
+  /// naming the accessor, before a joint number is used as an index.
+  void check_skin_component_types(const tinygltf::Primitive& primitive, const std::string& suffix,
+                                  const std::string& what) const {
+    const tinygltf::Accessor* joints = attribute_accessor(primitive, "JOINTS" + suffix);
+    const tinygltf::Accessor* weights = attribute_accessor(primitive, "WEIGHTS" + suffix);
+    const auto unsigned_integer = [](int type) {
+      return type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+             type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    };
+    if (joints != nullptr && (!unsigned_integer(joints->componentType) || joints->normalized)) {
+      fail(name_, what + ": JOINTS" + suffix + " (accessor " +
+                      std::to_string(primitive.attributes.at("JOINTS" + suffix)) +
+                      ") has component type " + std::to_string(joints->componentType) +
+                      (joints->normalized ? " normalized" : "") +
+                      ": joints must be UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)");
+    }
+    if (weights != nullptr &&
+        !(weights->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+          (unsigned_integer(weights->componentType) && weights->normalized))) {
+      fail(name_, what + ": WEIGHTS" + suffix + " (accessor " +
+                      std::to_string(primitive.attributes.at("WEIGHTS" + suffix)) +
+                      ") has component type " + std::to_string(weights->componentType) +
+                      (weights->normalized ? " normalized" : "") +
+                      ": weights must be FLOAT (5126) or normalized UNSIGNED_BYTE (5121) or "
+                      "UNSIGNED_SHORT (5123)");
     }
   }
 
