@@ -137,11 +137,7 @@ class MtlParser {
     } else {
       m.model = ShadingModel::BlinnPhong;
     }
-    if (const long found = library_.find(current_->name); found >= 0) {
-      library_.materials[static_cast<std::size_t>(found)] = std::move(*current_);
-    } else {
-      library_.materials.push_back(std::move(*current_));
-    }
+    library_.add(std::move(*current_));
     current_.reset();
     has_d_ = false;
     has_ks_ = false;
@@ -162,10 +158,17 @@ class MtlParser {
 }  // namespace
 
 long MtlLibrary::find(std::string_view name) const {
-  for (std::size_t i = 0; i < materials.size(); ++i) {
-    if (materials[i].name == name) return static_cast<long>(i);
+  const auto it = index_.find(std::string(name));
+  return it == index_.end() ? -1 : static_cast<long>(it->second);
+}
+
+void MtlLibrary::add(ObjMaterial material) {
+  const auto [it, added] = index_.try_emplace(material.name, materials.size());
+  if (added) {
+    materials.push_back(std::move(material));
+  } else {
+    materials[it->second] = std::move(material);
   }
-  return -1;
 }
 
 void parse_mtl(std::string_view text, const std::string& display_name,
