@@ -503,6 +503,43 @@ std::string jpeg_bytes(const std::vector<std::uint8_t>& rgba, int width, int hei
   return bytes;
 }
 
+/// A valid progressive JPEG of one 8x8 grey block (all coefficients 0, mid grey), written
+/// byte by byte, with successive approximation from bit `top` (<= 13, libjpeg's most) down
+/// to 0 for DC and for each AC coefficient on its own: (top + 1) * 64 scans. Each scan's
+/// data is one Huffman code (DC difference 0 or end of band, both the 1-bit code '0') or one
+/// refinement bit '0', padded with 1s: the byte 0x7F.
+std::string progressive_jpeg(int top) {
+  const auto segment = [](std::string& out, std::uint8_t marker, const std::string& body) {
+    out += '\xFF';
+    out += char(marker);
+    out += char((body.size() + 2) >> 8);
+    out += char((body.size() + 2) & 255);
+    out += body;
+  };
+  std::string out = "\xFF\xD8";
+  segment(out, 0xDB, std::string(1, '\0') + std::string(64, '\1'));            // DQT 0: all 1
+  segment(out, 0xC2, std::string("\x08\x00\x08\x00\x08\x01\x01\x11\x00", 9));  // SOF2 8x8
+  std::string huffman(17, '\0');
+  huffman[1] = 1;  // one code of length 1, for symbol 0
+  huffman += '\0';
+  segment(out, 0xC4, std::string(1, '\x00') + huffman.substr(1));  // DC table 0
+  segment(out, 0xC4, std::string(1, '\x10') + huffman.substr(1));  // AC table 0
+  const auto scan = [&](int first, int last, int high, int low) {
+    std::string body("\x01\x01\x00", 3);
+    body += char(first);
+    body += char(last);
+    body += char((high << 4) | low);
+    segment(out, 0xDA, body);
+    out += '\x7F';
+  };
+  for (int coefficient = 0; coefficient < 64; ++coefficient) {
+    scan(coefficient, coefficient, 0, top);
+    for (int bit = top; bit > 0; --bit) scan(coefficient, coefficient, bit, bit - 1);
+  }
+  out += "\xFF\xD9";
+  return out;
+}
+
 std::string png_bytes(int width, int height, std::uint8_t value) {
   covrast::Image image;
   image.width = width;
@@ -539,6 +576,23 @@ void write_file(const std::filesystem::path& path, const std::string& bytes) {
 }
 
 }  // namespace
+
+TEST_CASE("textures: a progressive JPEG of more than 500 scans is refused (issue 28)",
+          "[textures]") {
+  // 7 * 64 = 448 scans decode; 8 * 64 = 512 are past libjpeg-turbo's limit of 500 (a valid
+  // file of 2,080 scans of a larger image took 15 s and 991 MB before TJFLAG_LIMITSCANS).
+  const std::string fine = progressive_jpeg(6);
+  const covrast::RgbaImage image =
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(fine.data()), fine.size(), "j");
+  REQUIRE(image.width == 8);
+  REQUIRE(image.height == 8);
+  CHECK(int(image.rgba[0]) == Approx(128).margin(1));
+  const std::string many = progressive_jpeg(7);
+  REQUIRE_THROWS_WITH(
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(many.data()), many.size(),
+                            "many.jpg"),
+      "many.jpg: cannot decode image: Progressive JPEG image has more than 500 scans");
+}
 
 TEST_CASE("textures: PNG and JPEG decoded by content, from files, data URIs and buffer views",
           "[textures]") {
