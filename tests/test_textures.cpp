@@ -15,6 +15,7 @@
 #include <turbojpeg.h>
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -714,6 +715,30 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
                       Contains("image 0 (text.png)") && Contains("neither PNG nor JPEG"));
   REQUIRE_THROWS_WITH(load("data:image/png;base64," + covrast::test::base64("garbage!")),
                       Contains("m.gltf: image 0"));
+}
+
+TEST_CASE("textures: an image file over 1 GiB is refused from its size, unread (issue 28)",
+          "[textures]") {
+  // A sparse file of 1 GiB + 1 byte: it was read in full before its size was checked.
+  covrast::test::TempDir dir("covrast-textures");
+  const std::filesystem::path big = dir / "big.png";
+  write_file(big, "");
+  std::filesystem::resize_file(big, (std::uintmax_t(1) << 30) + 1);
+  const auto start = std::chrono::steady_clock::now();
+  REQUIRE_THROWS_WITH(covrast::read_image(big, "big.png"),
+                      "big.png: cannot read image: file of 1073741825 bytes is larger than the "
+                      "1 GiB limit");
+  write_file(dir / "m.gltf", textured_gltf("big.png"));
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "m.gltf"),
+                      Contains("m.gltf: image 0 (big.png): cannot read image: file of "
+                               "1073741825 bytes is larger than the 1 GiB limit"));
+  write_file(dir / "m.mtl", "newmtl a\nmap_Kd big.png\n");
+  write_file(dir / "m.obj",
+             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "m.obj"),
+                      Contains("m.obj: map_Kd big.png: cannot read image: file of 1073741825 "
+                               "bytes is larger than the 1 GiB limit"));
+  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 2.0);
 }
 
 TEST_CASE("textures: OBJ vt lines become corner UVs, v flipped to glTF's orientation",

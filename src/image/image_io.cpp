@@ -490,26 +490,38 @@ RgbaImage read_image(const std::filesystem::path& path, const std::string& name)
   const auto fail = [&](const std::string& why) {
     throw InputError(name + ": cannot read image: " + why);
   };
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    fail("not a regular file");
-  }
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) fail(errno_message(errno));
-  const std::unique_ptr<std::FILE, int (*)(std::FILE*)> closer(file, std::fclose);
+  // A path string with an embedded NUL would quietly open its prefix.
+  if (path.native().find('\0') != std::string::npos) fail("the path contains a NUL byte");
+  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat on the opened file then
+  // refuses what is not a regular file and, before a byte is read, a file over the limit
+  // (issue 28: a file near 1 GiB was read in full, into a growing buffer, before its size
+  // was checked).
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) fail(errno_message(errno));
+  const std::unique_ptr<int, void (*)(int*)> closer(new int(fd), [](int* f) {
+    ::close(*f);
+    delete f;
+  });
+  struct stat info {};
+  if (::fstat(fd, &info) != 0) fail(errno_message(errno));
+  if (!S_ISREG(info.st_mode)) fail("not a regular file");
   // Bounded: an image over the limits is refused from its header anyway, and no PNG or JPEG
   // of at most kMaxPngPixels needs more than this many bytes.
-  constexpr std::size_t kMaxImageFileBytes = std::size_t(1) << 30;
-  Bytes bytes;
-  std::uint8_t buffer[1 << 16];
-  for (;;) {
-    const std::size_t n = std::fread(buffer, 1, sizeof buffer, file);
-    bytes.insert(bytes.end(), buffer, buffer + n);
-    if (bytes.size() > kMaxImageFileBytes) fail("file larger than 1 GiB");
-    if (n < sizeof buffer) break;
+  constexpr std::uint64_t kMaxImageFileBytes = std::uint64_t(1) << 30;
+  const auto size = static_cast<std::uint64_t>(info.st_size);
+  if (size > kMaxImageFileBytes) {
+    fail("file of " + std::to_string(size) + " bytes is larger than the 1 GiB limit");
   }
-  if (std::ferror(file)) fail(errno_message(errno));
+  Bytes bytes(static_cast<std::size_t>(size));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t got = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) fail(errno_message(errno));
+    if (got == 0) break;  // the file shrank meanwhile: decode what is there
+    done += static_cast<std::size_t>(got);
+  }
+  bytes.resize(done);
   return decode_image(bytes.data(), bytes.size(), name);
 }
 

@@ -376,13 +376,12 @@ tinygltf::FsCallbacks gltf_fs_callbacks() {
   callbacks.ExpandFilePath = [](const std::string& path, void*) { return path; };
   callbacks.ReadWholeFile = [](std::vector<unsigned char>* out, std::string* err,
                                const std::string& path, void*) {
-    std::string bytes;
+    // Read straight into tinygltf's vector, its size checked before (fstat): no second copy.
     std::string error;
-    if (!read_whole_file(path, bytes, error)) {
+    if (!read_whole_file(path, *out, error)) {
       if (err != nullptr) *err += error;
       return false;
     }
-    out->assign(bytes.begin(), bytes.end());
     return true;
   };
   callbacks.WriteWholeFile = [](std::string* err, const std::string&,

@@ -62,6 +62,9 @@ struct LoadedMesh {
 /// file", a size over the limit, a NUL byte in the path). Never blocks on a FIFO or device.
 bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
                      std::uint64_t max_bytes = kMaxInputFileBytes);
+/// The same into bytes (tinygltf's buffers and images: read once, not copied).
+bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned char>& contents,
+                     std::string& error, std::uint64_t max_bytes = kMaxInputFileBytes);
 
 /// "1 GiB", "64 MiB" or "N bytes".
 std::string size_text(std::uint64_t bytes);
