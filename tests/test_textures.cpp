@@ -717,6 +717,71 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
                       Contains("m.gltf: image 0"));
 }
 
+TEST_CASE("textures: image URIs with a NUL, data: URIs of other media types (issue 28)",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  const auto load = [&](const std::string& uri) {
+    write_file(dir / "m.gltf", textured_gltf(uri));
+    return covrast::load_mesh(dir / "m.gltf");
+  };
+  write_file(dir / "t.png", png_bytes(2, 2, 40));
+  REQUIRE(load("t.png")->materials[0].base_color_texture.texture->levels[0].width == 2);
+  // "%00" decodes to a NUL: the part before it ("t.png") was opened, exit 0.
+  REQUIRE_THROWS_WITH(load("t.png%00.jpg"),
+                      Contains("m.gltf: image 0 (t.png%00.jpg): the path contains a NUL byte"));
+  // tinygltf takes a data: URI of a media type it does not know for a file name.
+  const std::string png = covrast::test::base64(png_bytes(2, 2, 40));
+  REQUIRE_THROWS_WITH(
+      load("data:text/html;base64," + png),
+      Contains("m.gltf: image 0: data: URI of media type 'text/html' (expected image/png, "
+               "image/jpeg or application/octet-stream)"));
+  REQUIRE_THROWS_WITH(
+      load("data:image/gif;base64," + png),
+      Contains("m.gltf: image 0: data: URI of media type 'image/gif' (expected image/png, "
+               "image/jpeg or application/octet-stream)"));
+  // Accepted, and decoded by their content.
+  for (const char* type : {"image/png", "image/jpeg", "application/octet-stream"}) {
+    INFO(type);
+    const auto mesh = load("data:" + std::string(type) + ";base64," + png);
+    REQUIRE(mesh->materials[0].base_color_texture.texture->levels[0].width == 2);
+  }
+}
+
+TEST_CASE("textures: image entries naming one file are decoded once (issue 28)", "[textures]") {
+  // Eight image entries naming one PNG were eight decoded copies (with a 2^26-pixel PNG of
+  // 196 KB: 3.45 GB from a 3.6 KB glTF). The same file, or buffer view, is decoded once.
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(4, 4, 90));
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  const int uv = b.add_floats({0, 0, 1, 0, 1, 1}, "VEC2");
+  const int view = b.add_view(png_bytes(4, 4, 90));
+  nlohmann::json primitives = nlohmann::json::array();
+  for (int i = 0; i < 8; ++i) {
+    primitives.push_back(
+        {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", i}});
+    b.gltf["materials"].push_back(
+        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", i}}}}}});
+    b.gltf["textures"].push_back({{"source", i}});
+    if (i < 4) {
+      b.gltf["images"].push_back({{"uri", i % 2 == 0 ? "t.png" : "./t.png"}});
+    } else {
+      b.gltf["images"].push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+    }
+  }
+  b.single_mesh(primitives);
+  write_file(dir / "m.gltf", b.gltf_text());
+  const auto mesh = covrast::load_mesh(dir / "m.gltf");
+  REQUIRE(mesh->materials.size() >= 8);
+  for (int i = 1; i < 8; ++i) {
+    INFO(i);
+    CHECK(mesh->materials[std::size_t(i)].base_color_texture.texture ==
+          mesh->materials[i < 4 ? 0 : 4].base_color_texture.texture);
+  }
+  CHECK(mesh->materials[0].base_color_texture.texture !=
+        mesh->materials[4].base_color_texture.texture);
+}
+
 TEST_CASE("textures: an image file over 1 GiB is refused from its size, unread (issue 28)",
           "[textures]") {
   // A sparse file of 1 GiB + 1 byte: it was read in full before its size was checked.
@@ -864,13 +929,21 @@ TEST_CASE("textures: TEXCOORD as normalized integers; a missing UV set is a warn
 TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") {
   covrast::test::TempDir dir("covrast-textures");
   write_file(dir / "k.png", png_bytes(3, 2, 64));
+  std::uint64_t texels = 0;
   const auto texture =
-      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true);
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true, texels);
   REQUIRE(texture->levels[0].width == 3);
   REQUIRE(texture->linear(0, 0, 0).g == Approx(srgb_decode(64)).epsilon(1e-12));
+  REQUIRE(texels == 6);
   REQUIRE_THROWS_WITH(
-      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
+      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true, texels),
       Contains("m.obj: map_Kd no.png: cannot read image"));
+  // The file's decoded images together stay within kMaxTextureTexels (issue 28).
+  texels = covrast::detail::kMaxTextureTexels - 5;
+  REQUIRE_THROWS_WITH(
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true, texels),
+      "m.obj: map_Kd k.png: its 3x2 texels take the file's decoded images past 134217728 "
+      "texels (docs/limits.md)");
 }
 
 TEST_CASE("textures: the base colour texture's alpha multiplies into BLEND and MASK",

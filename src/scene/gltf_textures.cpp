@@ -11,6 +11,10 @@ namespace covrast::detail {
 bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
                       const unsigned char* bytes, int size, void*) {
   if (image->bufferView >= 0) return true;  // read from the view, bounds-checked (decode())
+  // An image file (tinygltf keeps its uri, not a data: URI's): read again by decode() when a
+  // material uses it, once per distinct file, rather than a copy kept per image entry (eight
+  // entries naming one file were eight copies, issue 28).
+  if (!image->uri.empty()) return true;
   image->image.assign(bytes, bytes + size);
   image->as_is = true;
   return true;
@@ -91,11 +95,28 @@ glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fa
   return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
 }
 
+/// The media types of a glTF image's data: URI that covrast reads.
+constexpr std::string_view kImageDataUriTypes =
+    "expected image/png, image/jpeg or application/octet-stream";
+
 }  // namespace
 
+void count_texture_texels(int width, int height, const std::string& name,
+                          std::uint64_t& texels_used) {
+  const std::uint64_t texels = std::uint64_t(width) * std::uint64_t(height);
+  if (texels > kMaxTextureTexels - texels_used) {
+    throw InputError(name + ": its " + std::to_string(width) + "x" + std::to_string(height) +
+                     " texels take the file's decoded images past " +
+                     std::to_string(kMaxTextureTexels) + " texels (docs/limits.md)");
+  }
+  texels_used += texels;
+}
+
 std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
-                                                 const std::string& name, bool srgb) {
+                                                 const std::string& name, bool srgb,
+                                                 std::uint64_t& texels_used) {
   RgbaImage image = read_image(path, name);
+  count_texture_texels(image.width, image.height, name, texels_used);
   return make_texture(name, image.width, image.height, std::move(image.rgba), srgb);
 }
 
@@ -105,10 +126,39 @@ RgbaImage GltfTextures::decode(const tinygltf::Image& image, const std::string& 
     const std::size_t size = model_.bufferViews[std::size_t(image.bufferView)].byteLength;
     return decode_image(bytes, size, image_name);
   }
-  if (!image.image.empty()) return decode_image(image.image.data(), image.image.size(), image_name);
-  // tinygltf could not read the file (it only warns): read it here for the reason.
+  if (!image.image.empty()) {
+    // A data: URI tinygltf decoded; it names the media types it knows in mimeType (none for
+    // application/octet-stream). Only PNG and JPEG are read, by their content.
+    if (!image.mimeType.empty() && image.mimeType != "image/png" &&
+        image.mimeType != "image/jpeg") {
+      throw InputError(image_name + ": data: URI of media type '" + printable(image.mimeType) +
+                       "' (" + std::string(kImageDataUriTypes) + ")");
+    }
+    return decode_image(image.image.data(), image.image.size(), image_name);
+  }
   if (image.uri.empty()) throw InputError(image_name + ": no image data");
-  return read_image(base_dir_ / percent_decoded(image.uri), image_name);
+  // A data: URI of a media type tinygltf does not decode, which it takes for a file name.
+  if (image.uri.rfind("data:", 0) == 0) {
+    const std::size_t end = image.uri.find_first_of(";,", 5);
+    throw InputError(image_name + ": data: URI of media type '" +
+                     printable(image.uri.substr(5, std::min<std::size_t>(end, 60) - 5)) + "' (" +
+                     std::string(kImageDataUriTypes) + ")");
+  }
+  // An image file: read here (tinygltf's copy is not kept, keep_image_bytes), its size checked
+  // before it is read. A %00 escape would otherwise open the path before the NUL.
+  const std::string path = percent_decoded(image.uri);
+  if (path.find('\0') != std::string::npos) {
+    throw InputError(image_name + ": the path contains a NUL byte");
+  }
+  return read_image(base_dir_ / path, image_name);
+}
+
+std::string GltfTextures::source_key(int image_index, const tinygltf::Image& image) const {
+  if (image.bufferView >= 0) return "view " + std::to_string(image.bufferView);
+  if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0) {
+    return "file " + (base_dir_ / percent_decoded(image.uri)).lexically_normal().string();
+  }
+  return "image " + std::to_string(image_index);
 }
 
 std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool srgb,
@@ -125,10 +175,20 @@ std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool
   } else if (!image.name.empty()) {
     image_name += " (" + printable(image.name) + ")";
   }
+  // Image entries that name the same file or buffer view share one decoded texture.
+  const auto source = std::make_pair(source_key(image_index, image), srgb);
+  if (const auto it = by_source_.find(source); it != by_source_.end()) {
+    textures_.emplace(key, it->second);
+    return it->second;
+  }
   // The decoded bytes become level 0 (moved, not copied): nothing else keeps them.
   RgbaImage rgba = decode(image, image_name);
+  // The file's decoded images together stay within kMaxTextureTexels, checked before this
+  // one's mipmaps are built (docs/limits.md).
+  count_texture_texels(rgba.width, rgba.height, image_name, texels_);
   auto texture = make_texture(image_name, rgba.width, rgba.height, std::move(rgba.rgba), srgb);
   textures_.emplace(key, texture);
+  by_source_.emplace(source, texture);
   return texture;
 }
 
