@@ -684,6 +684,39 @@ TEST_CASE("textures: KHR_texture_transform and texCoord are read per slot", "[te
   REQUIRE(m.metallic_roughness_texture.texture->linear(0, 0, 0).r == Approx(200 / 255.0));
 }
 
+TEST_CASE("textures: KHR_texture_transform fields of a wrong type or range (issue 28)",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(2, 2, 200));
+  const auto load = [&](const nlohmann::json& transform) {
+    nlohmann::json extra;
+    extra["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorTexture",
+            {{"index", 0}, {"extensions", {{"KHR_texture_transform", transform}}}}}}}}};
+    write_file(dir / "t.gltf", textured_gltf("t.png", extra));
+    return covrast::load_mesh(dir / "t.gltf");
+  };
+  const std::string where = "t.gltf: material 0 baseColorTexture: ";
+  // texCoord 1e30 was converted to int first (undefined; "texCoord -2147483648").
+  REQUIRE_THROWS_WITH(load({{"texCoord", 1e30}}),
+                      Contains(where + "texCoord 1e+30 (covrast reads TEXCOORD_0 and TEXCOORD_1)"));
+  REQUIRE_THROWS_WITH(load({{"texCoord", -1e30}}), Contains(where + "texCoord -1e+30 ("));
+  REQUIRE_THROWS_WITH(load({{"texCoord", 0.5}}), Contains(where + "texCoord 0.5 ("));
+  REQUIRE_THROWS_WITH(load({{"texCoord", "1"}}),
+                      Contains(where + "KHR_texture_transform.texCoord: expected an integer >= 0"));
+  // Wrong types were ignored silently; the transform is used, so each is an error.
+  REQUIRE_THROWS_WITH(load({{"offset", "0.5"}}),
+                      Contains(where + "KHR_texture_transform.offset: expected an array of 2 "
+                                       "numbers"));
+  REQUIRE_THROWS_WITH(load({{"scale", {1, 2, 3}}}),
+                      Contains(where + "KHR_texture_transform.scale: expected an array of 2"));
+  REQUIRE_THROWS_WITH(load({{"rotation", {1}}}),
+                      Contains(where + "KHR_texture_transform.rotation: expected a number"));
+  REQUIRE(load({{"texCoord", 1.0}, {"rotation", 0.25}})->materials[0].base_color_texture.texcoord ==
+          1);
+}
+
 TEST_CASE("textures: bad images are InputErrors naming the image and the model", "[textures]") {
   covrast::test::TempDir dir("covrast-textures");
   const auto load = [&](const std::string& uri) {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string_view>
 
 namespace covrast::detail {
@@ -79,20 +80,29 @@ TextureSampler sampler_of(const tinygltf::Sampler& s) {
   return out;
 }
 
-double number_or(const tinygltf::Value& object, const char* key, double fallback) {
-  if (!object.Has(key) || !object.Get(key).IsNumber()) return fallback;
-  const double v = object.Get(key).GetNumberAsDouble();
-  return std::isfinite(v) ? v : fallback;
+/// KHR_texture_transform's number `key` of `object`, `fallback` when absent; any other type
+/// is an error (the schema says number: tinygltf would hand over anything).
+double number_or(const tinygltf::Value& object, const char* key, double fallback,
+                 const std::string& name, const std::string& where) {
+  if (!object.Has(key)) return fallback;
+  const tinygltf::Value& v = object.Get(key);
+  if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble())) {
+    fail(name, where + "." + key + ": expected a number");
+  }
+  return v.GetNumberAsDouble();
 }
 
-glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fallback) {
+/// KHR_texture_transform's pair `key` (offset, scale): an array of two numbers, or absent.
+glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fallback,
+                   const std::string& name, const std::string& where) {
   if (!object.Has(key)) return fallback;
   const tinygltf::Value& a = object.Get(key);
-  if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
-    return fallback;
+  if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber() ||
+      !std::isfinite(a.Get(0).GetNumberAsDouble()) ||
+      !std::isfinite(a.Get(1).GetNumberAsDouble())) {
+    fail(name, where + "." + key + ": expected an array of 2 numbers");
   }
-  const glm::dvec2 v(a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble());
-  return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
+  return {a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble()};
 }
 
 /// The media types of a glTF image's data: URI that covrast reads.
@@ -209,17 +219,29 @@ TextureSlot GltfTextures::slot(int texture_index, int texcoord,
   }
   out.texcoord = texcoord;
   // KHR_texture_transform on the textureInfo: offset, rotation, scale, texCoord override.
-  if (const auto it = extensions.find("KHR_texture_transform");
-      it != extensions.end() && it->second.IsObject()) {
+  // Each field of a wrong type is an error: the transform is used (issue 28).
+  const std::string texcoord_range = " (covrast reads TEXCOORD_0 and TEXCOORD_1)";
+  if (const auto it = extensions.find("KHR_texture_transform"); it != extensions.end()) {
     const tinygltf::Value& t = it->second;
-    out.transform.offset = pair_or(t, "offset", glm::dvec2(0.0));
-    out.transform.rotation = number_or(t, "rotation", 0.0);
-    out.transform.scale = pair_or(t, "scale", glm::dvec2(1.0));
-    out.texcoord = int(number_or(t, "texCoord", double(texcoord)));
+    const std::string where = what + ": KHR_texture_transform";
+    if (!t.IsObject()) fail(reader_.name, where + ": expected an object");
+    out.transform.offset = pair_or(t, "offset", glm::dvec2(0.0), reader_.name, where);
+    out.transform.rotation = number_or(t, "rotation", 0.0, reader_.name, where);
+    out.transform.scale = pair_or(t, "scale", glm::dvec2(1.0), reader_.name, where);
+    if (t.Has("texCoord")) {
+      // Range-checked as a double before it becomes an int (1e30 was undefined behaviour).
+      const tinygltf::Value& set = t.Get("texCoord");
+      if (!set.IsNumber()) fail(reader_.name, where + ".texCoord: expected an integer >= 0");
+      const std::optional<int> index = whole_number(set, 0, kMaxTexcoordSets - 1);
+      if (!index) {
+        fail(reader_.name,
+             what + ": texCoord " + number_text(set.GetNumberAsDouble()) + texcoord_range);
+      }
+      out.texcoord = *index;
+    }
   }
   if (out.texcoord < 0 || out.texcoord >= kMaxTexcoordSets) {
-    fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) +
-                           " (covrast reads TEXCOORD_0 and TEXCOORD_1)");
+    fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) + texcoord_range);
   }
   out.texture = image_texture(texture.source, srgb, what);
   return out;
