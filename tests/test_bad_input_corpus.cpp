@@ -724,8 +724,14 @@ std::vector<Case> png_cases() {
   put_chunk(empty_idat, "IEND", "");
   std::string bad_crc = good;
   bad_crc[29] = static_cast<char>(bad_crc[29] ^ 1);  // inside IHDR's CRC
+  // Issue 28: the CRC of the last IDAT chunk (the 4 bytes before IEND's 12) was not checked.
+  std::string bad_idat_crc = good;
+  const std::size_t iend = bad_idat_crc.size() - 12;
+  bad_idat_crc[iend - 1] = static_cast<char>(bad_idat_crc[iend - 1] ^ 1);
   const std::string pixels = std::to_string(covrast::kMaxPngPixels);
   return {
+      compare_case("png: IDAT CRC wrong", bad_idat_crc,
+                   "a.png: cannot read PNG: invalid chunk checksum"),
       compare_case("png: not a PNG", "hello", "a.png: cannot read PNG: not a PNG file"),
       compare_case("png: empty", "", "a.png: cannot read PNG: not a PNG file"),
       compare_case("png: signature only", kPngSignature,

@@ -559,6 +559,44 @@ std::uint32_t crc32(const std::string& bytes) {
   return ~crc;
 }
 
+/// An indexed-colour PNG (bit depth 8, one row of `indices`) with `palette` (RGB triples) and
+/// tRNS `alphas` when not empty; the image data as a stored (uncompressed) zlib stream.
+std::string indexed_png(const std::string& indices, const std::string& palette,
+                        const std::string& alphas) {
+  const auto be32 = [](std::string& out, std::uint32_t v) {
+    for (int i = 3; i >= 0; --i) out += char((v >> (8 * i)) & 255u);
+  };
+  const auto chunk = [&](std::string& out, const std::string& type, const std::string& data) {
+    be32(out, std::uint32_t(data.size()));
+    out += type + data;
+    be32(out, crc32(type + data));
+  };
+  std::string ihdr;
+  be32(ihdr, std::uint32_t(indices.size()));
+  be32(ihdr, 1);
+  ihdr += std::string("\x08\x03\x00\x00\x00", 5);
+  const std::string row = std::string(1, '\0') + indices;  // filter type 0
+  std::string zlib = "\x78\x01\x01";                       // one final stored block
+  zlib += char(row.size() & 255u);
+  zlib += char(row.size() >> 8);
+  zlib += char(~row.size() & 255u);
+  zlib += char((~row.size() >> 8) & 255u);
+  zlib += row;
+  std::uint32_t a = 1, b = 0;  // Adler-32
+  for (const char c : row) {
+    a = (a + std::uint8_t(c)) % 65521u;
+    b = (b + a) % 65521u;
+  }
+  be32(zlib, (b << 16) | a);
+  std::string out = "\x89PNG\r\n\x1a\n";
+  chunk(out, "IHDR", ihdr);
+  chunk(out, "PLTE", palette);
+  if (!alphas.empty()) chunk(out, "tRNS", alphas);
+  chunk(out, "IDAT", zlib);
+  chunk(out, "IEND", "");
+  return out;
+}
+
 /// A glTF quad whose baseColorTexture is image 0 at `uri`.
 std::string textured_gltf(const std::string& uri, const nlohmann::json& extra = {}) {
   covrast::test::GltfBuilder b;
@@ -748,6 +786,32 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
                       Contains("image 0 (text.png)") && Contains("neither PNG nor JPEG"));
   REQUIRE_THROWS_WITH(load("data:image/png;base64," + covrast::test::base64("garbage!")),
                       Contains("m.gltf: image 0"));
+  // Issue 28: a wrong CRC on the last IDAT chunk decoded without a word.
+  std::string bad_crc = png_bytes(4, 4, 40);
+  const std::size_t iend = bad_crc.size() - 12;
+  bad_crc[iend - 1] = char(bad_crc[iend - 1] ^ 1);
+  write_file(dir / "crc.png", bad_crc);
+  REQUIRE_THROWS_WITH(load("crc.png"),
+                      Contains("m.gltf: image 0 (crc.png): cannot decode image: invalid "
+                               "chunk checksum"));
+}
+
+TEST_CASE("textures: an indexed PNG's index past its palette is an error (issue 28)",
+          "[textures]") {
+  // Two entries (red, green), alpha 128 for the first; indices 0, 1, then 5: libspng looked
+  // index 5 up without a word.
+  const std::string palette("\xFF\x00\x00\x00\xFF\x00", 6);
+  const std::string good = indexed_png(std::string("\x00\x01", 2), palette, "\x80");
+  const covrast::RgbaImage image = covrast::decode_image(
+      reinterpret_cast<const std::uint8_t*>(good.data()), good.size(), "p.png");
+  REQUIRE(image.width == 2);
+  CHECK(std::vector<int>(image.rgba.begin(), image.rgba.end()) ==
+        std::vector<int>{255, 0, 0, 128, 0, 255, 0, 255});
+  const std::string bad = indexed_png(std::string("\x00\x01\x05", 3), palette, "");
+  REQUIRE_THROWS_WITH(
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(bad.data()), bad.size(), "p.png"),
+      "p.png: cannot decode image: palette index 5 at (2, 0) is past the "
+      "palette's 2 entries");
 }
 
 TEST_CASE("textures: image URIs with a NUL, data: URIs of other media types (issue 28)",

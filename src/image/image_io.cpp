@@ -377,6 +377,8 @@ Image read_png(const std::filesystem::path& path) {
       error != 0) {
     return fail(reason(error));
   }
+  // The last IDAT chunk's CRC is checked only when libspng reads on (decode_png_rgba).
+  if (const int error = spng_decode_chunks(ctx); error != 0) return fail(reason(error));
   return image;
 }
 
@@ -394,6 +396,45 @@ std::string over_limits(std::uint64_t width, std::uint64_t height) {
            ") covrast reads";
   }
   return {};
+}
+
+/// An indexed PNG: libspng looks up an index past the palette without a word (issue 28), so
+/// the indices are decoded as they are stored, each checked, then looked up here in the
+/// palette, with tRNS as alpha.
+void decode_indexed_png(spng_ctx* ctx, const spng_ihdr& ihdr, RgbaImage& image,
+                        const std::function<void(const std::string&)>& fail) {
+  spng_plte plte{};
+  if (const int error = spng_get_plte(ctx, &plte); error != 0) fail(spng_strerror(error));
+  spng_trns trns{};
+  const bool has_trns = spng_get_trns(ctx, &trns) == 0;
+  std::size_t raw_size = 0;
+  if (const int error = spng_decoded_image_size(ctx, SPNG_FMT_PNG, &raw_size); error != 0) {
+    fail(spng_strerror(error));
+  }
+  Bytes raw(raw_size);
+  if (const int error = spng_decode_image(ctx, raw.data(), raw_size, SPNG_FMT_PNG, 0); error != 0) {
+    fail(spng_strerror(error));
+  }
+  const std::size_t width = ihdr.width, height = ihdr.height, bits = ihdr.bit_depth;
+  const std::size_t row_bytes = raw_size / height;
+  image.rgba.resize(width * height * 4);
+  for (std::size_t y = 0; y < height; ++y) {
+    for (std::size_t x = 0; x < width; ++x) {
+      const std::size_t bit = x * bits;
+      const unsigned byte = raw[y * row_bytes + bit / 8];
+      const unsigned index = (byte >> (8 - bits - bit % 8)) & ((1u << bits) - 1u);
+      if (index >= plte.n_entries) {
+        fail("palette index " + std::to_string(index) + " at (" + std::to_string(x) + ", " +
+             std::to_string(y) + ") is past the palette's " + std::to_string(plte.n_entries) +
+             " entries");
+      }
+      std::uint8_t* out = &image.rgba[(y * width + x) * 4];
+      out[0] = plte.entries[index].red;
+      out[1] = plte.entries[index].green;
+      out[2] = plte.entries[index].blue;
+      out[3] = has_trns && index < trns.n_type3_entries ? trns.type3_alpha[index] : 255;
+    }
+  }
 }
 
 /// PNG from memory through libspng, as RGBA8 with tRNS applied.
@@ -414,12 +455,20 @@ RgbaImage decode_png_rgba(const std::uint8_t* bytes, std::size_t size,
   RgbaImage image;
   image.width = int(ihdr.width);
   image.height = int(ihdr.height);
-  image.rgba.resize(out_size);
-  if (const int error =
-          spng_decode_image(ctx, image.rgba.data(), out_size, SPNG_FMT_RGBA8, SPNG_DECODE_TRNS);
-      error != 0) {
-    fail(spng_strerror(error));
+  if (ihdr.color_type == SPNG_COLOR_TYPE_INDEXED) {
+    decode_indexed_png(ctx, ihdr, image, fail);
+  } else {
+    image.rgba.resize(out_size);
+    if (const int error =
+            spng_decode_image(ctx, image.rgba.data(), out_size, SPNG_FMT_RGBA8, SPNG_DECODE_TRNS);
+        error != 0) {
+      fail(spng_strerror(error));
+    }
   }
+  // libspng checks the last IDAT chunk's CRC only when it reads on: a PNG whose image data
+  // fails its checksum decoded without a word (issue 28). The chunks after the image are
+  // read here (bounded by the chunk limits), so that it and a missing IEND are errors.
+  if (const int error = spng_decode_chunks(ctx); error != 0) fail(spng_strerror(error));
   return image;
 }
 
