@@ -51,6 +51,34 @@ TextureWrap wrap_mode(int code) {
   return TextureWrap::Repeat;
 }
 
+/// glTF 2.0, 5.26: the sampler's enums are these codes (or absent: -1 for the filters). A
+/// sampler a material uses with any other code is an error (issue 28: they were taken for
+/// the defaults without a word).
+void check_sampler(const tinygltf::Sampler& s, const std::string& name, const std::string& what) {
+  const auto wrap = [](int code) {
+    return code == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ||
+           code == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT || code == TINYGLTF_TEXTURE_WRAP_REPEAT;
+  };
+  if (s.magFilter != -1 && s.magFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+      s.magFilter != TINYGLTF_TEXTURE_FILTER_LINEAR) {
+    fail(name, what + ": magFilter " + std::to_string(s.magFilter) +
+                   " is not 9728 (NEAREST) or 9729 (LINEAR)");
+  }
+  if (s.minFilter != -1 && s.minFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+      s.minFilter != TINYGLTF_TEXTURE_FILTER_LINEAR &&
+      !(s.minFilter >= TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST &&
+        s.minFilter <= TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR)) {
+    fail(name,
+         what + ": minFilter " + std::to_string(s.minFilter) + " is not 9728, 9729 or 9984..9987");
+  }
+  if (!wrap(s.wrapS) || !wrap(s.wrapT)) {
+    fail(name, what + ": " +
+                   (wrap(s.wrapS) ? "wrapT " + std::to_string(s.wrapT)
+                                  : "wrapS " + std::to_string(s.wrapS)) +
+                   " is not 33071, 33648 or 10497");
+  }
+}
+
 TextureSampler sampler_of(const tinygltf::Sampler& s) {
   TextureSampler out;
   out.wrap_s = wrap_mode(s.wrapS);
@@ -215,7 +243,9 @@ TextureSlot GltfTextures::slot(int texture_index, int texcoord,
     if (std::size_t(texture.sampler) >= model_.samplers.size()) {
       fail(reader_.name, what + ": sampler " + std::to_string(texture.sampler) + " does not exist");
     }
-    out.sampler = sampler_of(model_.samplers[std::size_t(texture.sampler)]);
+    const tinygltf::Sampler& sampler = model_.samplers[std::size_t(texture.sampler)];
+    check_sampler(sampler, reader_.name, what + ": sampler " + std::to_string(texture.sampler));
+    out.sampler = sampler_of(sampler);
   }
   out.texcoord = texcoord;
   // KHR_texture_transform on the textureInfo: offset, rotation, scale, texCoord override.
