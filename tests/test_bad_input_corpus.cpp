@@ -533,7 +533,108 @@ std::vector<Case> gltf_cases() {
   std::string overflow = with([](json& d) { d["asset"]["extras"] = 12345; });
   overflow.replace(overflow.find("12345"), 5, "1e400");
   const std::string depth_text = std::to_string(covrast::kMaxJsonDepth);
+  // Issue 28: a skinned triangle whose JOINTS_0 are floats of -1e10 (was a segfault).
+  const std::string float_joints = [] {
+    GltfBuilder builder = triangle_gltf();
+    const int joints =
+        builder.add_floats({-1e10f, 0, 0, 0, -1e10f, 0, 0, 0, -1e10f, 0, 0, 0}, "VEC4");
+    const int weights = builder.add_floats({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, "VEC4");
+    builder.gltf["scenes"][0]["nodes"] = {0, 1};
+    builder.gltf["nodes"] = {{{"mesh", 0}, {"skin", 0}}, json::object()};
+    builder.gltf["skins"] = {{{"joints", {1}}}};
+    builder.gltf["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = joints;
+    builder.gltf["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = weights;
+    return builder.gltf_text();
+  }();
+  // Issue 28: a textured triangle (a 2x2 PNG as a data: URI); `edit` changes it.
+  const auto textured = [](const std::function<void(json&)>& edit) {
+    GltfBuilder builder = triangle_gltf();
+    const int uv = builder.add_floats({0, 0, 1, 0, 0, 1}, "VEC2");
+    builder.gltf["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
+    builder.gltf["meshes"][0]["primitives"][0]["material"] = 0;
+    builder.gltf["materials"] = {
+        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+    builder.gltf["textures"] = {{{"source", 0}, {"sampler", 0}}};
+    builder.gltf["samplers"] = {json::object()};
+    const std::string png = good_png(2, 2);
+    builder.gltf["images"] = {{{"uri", "data:image/png;base64," + covrast::test::base64(png)}}};
+    edit(builder.gltf);
+    return builder.gltf_text();
+  };
+  const std::string sparse_unsorted = [] {
+    GltfBuilder builder = triangle_gltf();
+    std::string indices;
+    covrast::test::put_u16(indices, 2);
+    covrast::test::put_u16(indices, 1);
+    const int index_view = builder.add_view(indices);
+    std::string values;
+    for (int k = 0; k < 6; ++k) covrast::test::put_f32(values, 0.5f);
+    const int value_view = builder.add_view(values);
+    builder.gltf["accessors"][0]["sparse"] = {
+        {"count", 2},
+        {"indices", {{"bufferView", index_view}, {"componentType", 5123}}},
+        {"values", {{"bufferView", value_view}}}};
+    return builder.gltf_text();
+  }();
+  const auto with_light = [](const std::string& type) {
+    GltfBuilder builder = triangle_gltf();
+    builder.gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    builder.gltf["extensions"] = {
+        {"KHR_lights_punctual", {{"lights", {{{"type", type}, {"range", 0}}}}}}};
+    builder.gltf["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
+    return builder.gltf_text();
+  };
   return {
+      gltf_case("gltf: sampler magFilter 1234",
+                textured([](json& d) { d["samplers"][0]["magFilter"] = 1234; }),
+                "m.gltf: material 0 baseColorTexture: sampler 0: magFilter 1234 is not 9728 "
+                "(NEAREST) or 9729 (LINEAR)"),
+      gltf_case("gltf: sampler minFilter 9730",
+                textured([](json& d) { d["samplers"][0]["minFilter"] = 9730; }),
+                "m.gltf: material 0 baseColorTexture: sampler 0: minFilter 9730 is not"),
+      gltf_case("gltf: sampler wrapT 0", textured([](json& d) { d["samplers"][0]["wrapT"] = 0; }),
+                "m.gltf: material 0 baseColorTexture: sampler 0: wrapT 0 is not 33071, 33648 or "
+                "10497"),
+      gltf_case("gltf: texture transform texCoord 1e30", textured([](json& d) {
+                  d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+                      {"KHR_texture_transform", {{"texCoord", 1e30}}}};
+                }),
+                "m.gltf: material 0 baseColorTexture: texCoord 1e+30 (covrast reads TEXCOORD_0 "
+                "and TEXCOORD_1)"),
+      gltf_case("gltf: texture transform offset a string", textured([](json& d) {
+                  d["materials"][0]["pbrMetallicRoughness"]["baseColorTexture"]["extensions"] = {
+                      {"KHR_texture_transform", {{"offset", "1"}}}};
+                }),
+                "m.gltf: material 0 baseColorTexture: KHR_texture_transform.offset: expected an "
+                "array of 2 numbers"),
+      gltf_case("gltf: image uri with %00",
+                textured([](json& d) { d["images"][0]["uri"] = "s.json%00.png"; }),
+                "m.gltf: image 0 (s.json%00.png): the path contains a NUL byte"),
+      gltf_case("gltf: image data: URI of text/html",
+                textured([](json& d) { d["images"][0]["uri"] = "data:text/html;base64,PGI+"; }),
+                "m.gltf: image 0: data: URI of media type 'text/html' (expected image/png, "
+                "image/jpeg or application/octet-stream)"),
+      gltf_case("gltf: alphaCutoff -1 in MASK mode", textured([](json& d) {
+                  d["materials"][0]["alphaMode"] = "MASK";
+                  d["materials"][0]["alphaCutoff"] = -1;
+                }),
+                "m.gltf: material 0: alphaCutoff -1 must be >= 0"),
+      gltf_case("gltf: alphaCutoff -1 unused",
+                textured([](json& d) { d["materials"][0]["alphaCutoff"] = -1; }),
+                "m.gltf: material 0: alphaCutoff -1 must be >= 0 (ignored: alphaMode is OPAQUE)",
+                "m.gltf", true),
+      gltf_case("gltf: sparse indices unsorted", sparse_unsorted,
+                "m.gltf: mesh 0 primitive 0 POSITION: sparse indices must strictly increase (2 "
+                "then 1)"),
+      gltf_case("gltf: point light range 0", with_light("point"),
+                "m.gltf: KHR_lights_punctual lights[0].range: expected a number > 0, got 0"),
+      gltf_case("gltf: directional light range 0", with_light("directional"),
+                "m.gltf: KHR_lights_punctual lights[0].range: expected a number > 0, got 0 "
+                "(ignored: a directional light has no range)",
+                "m.gltf", true),
+      gltf_case("gltf: skin joints of -1e10 as FLOAT", float_joints,
+                "m.gltf: mesh 0 primitive 0: JOINTS_0 (accessor 1) has component type 5126: "
+                "joints must be UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)"),
       gltf_case("gltf: not JSON", "hello", "m.gltf: not a glTF file"),
       gltf_case("gltf: empty file", "", "m.gltf: not a glTF file"),
       gltf_case("gltf: an OBJ", kTriangleObj, "m.gltf: not a glTF file"),
@@ -724,8 +825,14 @@ std::vector<Case> png_cases() {
   put_chunk(empty_idat, "IEND", "");
   std::string bad_crc = good;
   bad_crc[29] = static_cast<char>(bad_crc[29] ^ 1);  // inside IHDR's CRC
+  // Issue 28: the CRC of the last IDAT chunk (the 4 bytes before IEND's 12) was not checked.
+  std::string bad_idat_crc = good;
+  const std::size_t iend = bad_idat_crc.size() - 12;
+  bad_idat_crc[iend - 1] = static_cast<char>(bad_idat_crc[iend - 1] ^ 1);
   const std::string pixels = std::to_string(covrast::kMaxPngPixels);
   return {
+      compare_case("png: IDAT CRC wrong", bad_idat_crc,
+                   "a.png: cannot read PNG: invalid chunk checksum"),
       compare_case("png: not a PNG", "hello", "a.png: cannot read PNG: not a PNG file"),
       compare_case("png: empty", "", "a.png: cannot read PNG: not a PNG file"),
       compare_case("png: signature only", kPngSignature,
@@ -858,6 +965,34 @@ std::vector<Case> output_cases() {
        {"render", "s.json", "-o", "out.png", "--depth", "/proc/covrast-depth.pfm"},
        2,
        "/proc/covrast-depth.pfm: cannot write: "},
+      // Issue 28: a directory to be made where a regular file is was "internal error:
+      // filesystem error", exit 1.
+      {"output: test --report names a regular file",
+       {{"t.json", R"({"cases":[{"name":"c","scene":"s.json","golden":"g.png"}]})"},
+        {"s.json", scene_text()},
+        {"m.obj", kTriangleObj},
+        {"g.png", good_png(8, 8)},
+        {"r.txt", "x"}},
+       {"test", "t.json", "--report", "r.txt"},
+       2,
+       "r.txt: cannot create the directory: "},
+      {"output: test --artifacts names a regular file",
+       {{"t.json", R"({"cases":[{"name":"c","scene":"s.json","golden":"g.png"}]})"},
+        {"s.json", scene_text()},
+        {"m.obj", kTriangleObj},
+        {"g.png", good_png(8, 8)},
+        {"a.txt", "x"}},
+       {"test", "t.json", "--artifacts", "a.txt"},
+       2,
+       "a.txt: cannot create the directory: "},
+      {"output: test --update of a golden under a regular file",
+       {{"t.json", R"({"cases":[{"name":"c","scene":"s.json","golden":"f.txt/g.png"}]})"},
+        {"s.json", scene_text()},
+        {"m.obj", kTriangleObj},
+        {"f.txt", "x"}},
+       {"test", "t.json", "--update"},
+       2,
+       "f.txt: cannot create the directory: "},
       {"output: heatmap under /proc",
        {{"a.png", good_png(4, 4)}, {"b.png", good_png(4, 4)}},
        {"compare", "a.png", "b.png", "--heatmap", "/proc/covrast-heat.png"},

@@ -20,6 +20,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <memory>
 #include <string>
 #include <tuple>
@@ -434,6 +436,55 @@ TEST_CASE("glTF skins pose the vertices by the joints' static transforms", "[glt
   b.gltf["scenes"][0]["nodes"] = {0};
   REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("scene.glb", b.glb())),
                       Contains("scene.glb: node 0: skin 0: joint node 1 is not in the scene"));
+}
+
+TEST_CASE("glTF skin joints must be unsigned integers within the skin (issue 28)", "[gltf]") {
+  TempDir dir;
+  // Float joints (-1e10 or -1) and signed bytes (-1) were converted to indices: a crash or
+  // a read before the joint matrices. The component type is checked, naming the accessor.
+  const auto with_joints = [](const std::function<int(GltfBuilder&)>& add) {
+    GltfBuilder b = skinned_triangle();
+    b.gltf["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = add(b);
+    return b;
+  };
+  const std::string message =
+      "mesh 0 primitive 0: JOINTS_0 (accessor 5) has component type 5126: joints must be "
+      "UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)";
+  for (const float value : {-1e10f, -1.0f, std::numeric_limits<float>::quiet_NaN()}) {
+    const GltfBuilder b = with_joints([&](GltfBuilder& g) {
+      return g.add_floats({value, 0, 0, 0, value, 0, 0, 0, value, 0, 0, 0}, "VEC4");
+    });
+    REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("float.glb", b.glb())),
+                        Contains("float.glb: " + message));
+  }
+  GltfBuilder b = with_joints([](GltfBuilder& g) {
+    std::string bytes(12, '\0');
+    bytes[0] = bytes[4] = bytes[8] = '\xff';  // -1 as a signed byte
+    const int view = g.add_view(bytes);
+    g.gltf["accessors"].push_back(
+        {{"bufferView", view}, {"componentType", 5120}, {"count", 3}, {"type", "VEC4"}});
+    return static_cast<int>(g.gltf["accessors"].size()) - 1;
+  });
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("byte.glb", b.glb())),
+                      Contains("byte.glb: mesh 0 primitive 0: JOINTS_0 (accessor 5) has component "
+                               "type 5120: joints must be"));
+  // Weights: FLOAT or normalized unsigned integers only.
+  b = skinned_triangle();
+  b.gltf["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] =
+      b.add_u16({65535, 0, 0, 0, 65535, 0, 0, 0, 65535, 0, 0, 0}, "VEC4");
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir.write("weights.glb", b.glb())),
+                      Contains("weights.glb: mesh 0 primitive 0: WEIGHTS_0 (accessor 5) has "
+                               "component type 5123: weights must be FLOAT"));
+  b.gltf["accessors"][5]["normalized"] = true;
+  const auto mesh = covrast::load_mesh(dir.write("normalized.glb", b.glb()));
+  REQUIRE(mesh->positions.size() == 3);
+  // An unsigned joint number past the skin's joints is an error, not a read past them.
+  b = skinned_triangle();
+  b.gltf["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] =
+      b.add_u16({65535, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0}, "VEC4");
+  REQUIRE_THROWS_WITH(
+      covrast::load_mesh(dir.write("range.glb", b.glb())),
+      Contains("range.glb: mesh 0 primitive 0: joint 65535 out of range (2 joints)"));
 }
 
 TEST_CASE("EXT_mesh_gpu_instancing draws the mesh once per instance", "[gltf]") {

@@ -356,6 +356,39 @@ TEST_CASE("degenerate OBJ polygons fall back to the fan with a warning, l and p 
             obj + ": 2 line (l) and 1 point (p) statements not drawn: covrast draws faces only"});
 }
 
+TEST_CASE("OBJ map_Kd file names with spaces are read whole, after the options (issue 28)",
+          "[obj][mtl][textures]") {
+  TempDir dir;
+  std::vector<std::uint8_t> texels(4 * 4 * 3, 90);
+  covrast::write_png(covrast::Image{4, 4, texels}, dir / "my tex.png");
+  covrast::write_png(covrast::Image{4, 4, texels}, dir / "-dash.png");
+  const std::string obj =
+      "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\n"
+      "f 1/1 2/1 3/1\n";
+  dir.write("m.obj", obj);
+  // The last token ("tex.png") was taken: a missing file.
+  for (const char* line :
+       {"map_Kd my tex.png", "map_Kd  my tex.png  ", "map_Kd -s 1 1 1 my tex.png",
+        "map_Kd -o 0.5 my tex.png", "map_Kd -bm 0.2 -clamp on my tex.png",
+        "map_Kd -blendu on -blendv off -mm 0 1 -t 1 2 my tex.png",
+        "map_Kd -imfchan r -texres 64 -cc off -boost 2 my tex.png"}) {
+    INFO(line);
+    dir.write("m.mtl", "newmtl a\n" + std::string(line) + "\n");
+    const auto mesh = covrast::load_mesh(dir / "m.obj");
+    REQUIRE(mesh->materials[0].base_color_texture.texture != nullptr);
+    CHECK(mesh->materials[0].base_color_texture_path == (dir / "my tex.png").string());
+  }
+  // A name that starts with '-' but is no option is the file name.
+  dir.write("m.mtl", "newmtl a\nmap_Kd -dash.png\n");
+  CHECK(covrast::load_mesh(dir / "m.obj")->materials[0].base_color_texture.texture != nullptr);
+  dir.write("m.mtl", "newmtl a\nmap_Kd -s 1 1 1\n");
+  CHECK_THROWS_WITH(covrast::load_mesh(dir / "m.obj"),
+                    Catch::Matchers::Contains("m.mtl:2: map_Kd: expected a file name"));
+  dir.write("m.mtl", "newmtl a\nmap_Kd -bm\n");
+  CHECK_THROWS_WITH(covrast::load_mesh(dir / "m.obj"),
+                    Catch::Matchers::Contains("m.mtl:2: map_Kd: option -bm needs a value"));
+}
+
 TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file, missing is an error",
           "[obj][mtl][textures]") {
   TempDir dir;

@@ -15,6 +15,7 @@
 #include <turbojpeg.h>
 #include <catch2/catch.hpp>
 
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -503,6 +504,43 @@ std::string jpeg_bytes(const std::vector<std::uint8_t>& rgba, int width, int hei
   return bytes;
 }
 
+/// A valid progressive JPEG of one 8x8 grey block (all coefficients 0, mid grey), written
+/// byte by byte, with successive approximation from bit `top` (<= 13, libjpeg's most) down
+/// to 0 for DC and for each AC coefficient on its own: (top + 1) * 64 scans. Each scan's
+/// data is one Huffman code (DC difference 0 or end of band, both the 1-bit code '0') or one
+/// refinement bit '0', padded with 1s: the byte 0x7F.
+std::string progressive_jpeg(int top) {
+  const auto segment = [](std::string& out, std::uint8_t marker, const std::string& body) {
+    out += '\xFF';
+    out += char(marker);
+    out += char((body.size() + 2) >> 8);
+    out += char((body.size() + 2) & 255);
+    out += body;
+  };
+  std::string out = "\xFF\xD8";
+  segment(out, 0xDB, std::string(1, '\0') + std::string(64, '\1'));            // DQT 0: all 1
+  segment(out, 0xC2, std::string("\x08\x00\x08\x00\x08\x01\x01\x11\x00", 9));  // SOF2 8x8
+  std::string huffman(17, '\0');
+  huffman[1] = 1;  // one code of length 1, for symbol 0
+  huffman += '\0';
+  segment(out, 0xC4, std::string(1, '\x00') + huffman.substr(1));  // DC table 0
+  segment(out, 0xC4, std::string(1, '\x10') + huffman.substr(1));  // AC table 0
+  const auto scan = [&](int first, int last, int high, int low) {
+    std::string body("\x01\x01\x00", 3);
+    body += char(first);
+    body += char(last);
+    body += char((high << 4) | low);
+    segment(out, 0xDA, body);
+    out += '\x7F';
+  };
+  for (int coefficient = 0; coefficient < 64; ++coefficient) {
+    scan(coefficient, coefficient, 0, top);
+    for (int bit = top; bit > 0; --bit) scan(coefficient, coefficient, bit, bit - 1);
+  }
+  out += "\xFF\xD9";
+  return out;
+}
+
 std::string png_bytes(int width, int height, std::uint8_t value) {
   covrast::Image image;
   image.width = width;
@@ -519,6 +557,44 @@ std::uint32_t crc32(const std::string& bytes) {
     for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xEDB88320u & (0u - (crc & 1u)));
   }
   return ~crc;
+}
+
+/// An indexed-colour PNG (bit depth 8, one row of `indices`) with `palette` (RGB triples) and
+/// tRNS `alphas` when not empty; the image data as a stored (uncompressed) zlib stream.
+std::string indexed_png(const std::string& indices, const std::string& palette,
+                        const std::string& alphas) {
+  const auto be32 = [](std::string& out, std::uint32_t v) {
+    for (int i = 3; i >= 0; --i) out += char((v >> (8 * i)) & 255u);
+  };
+  const auto chunk = [&](std::string& out, const std::string& type, const std::string& data) {
+    be32(out, std::uint32_t(data.size()));
+    out += type + data;
+    be32(out, crc32(type + data));
+  };
+  std::string ihdr;
+  be32(ihdr, std::uint32_t(indices.size()));
+  be32(ihdr, 1);
+  ihdr += std::string("\x08\x03\x00\x00\x00", 5);
+  const std::string row = std::string(1, '\0') + indices;  // filter type 0
+  std::string zlib = "\x78\x01\x01";                       // one final stored block
+  zlib += char(row.size() & 255u);
+  zlib += char(row.size() >> 8);
+  zlib += char(~row.size() & 255u);
+  zlib += char((~row.size() >> 8) & 255u);
+  zlib += row;
+  std::uint32_t a = 1, b = 0;  // Adler-32
+  for (const char c : row) {
+    a = (a + std::uint8_t(c)) % 65521u;
+    b = (b + a) % 65521u;
+  }
+  be32(zlib, (b << 16) | a);
+  std::string out = "\x89PNG\r\n\x1a\n";
+  chunk(out, "IHDR", ihdr);
+  chunk(out, "PLTE", palette);
+  if (!alphas.empty()) chunk(out, "tRNS", alphas);
+  chunk(out, "IDAT", zlib);
+  chunk(out, "IEND", "");
+  return out;
 }
 
 /// A glTF quad whose baseColorTexture is image 0 at `uri`.
@@ -539,6 +615,23 @@ void write_file(const std::filesystem::path& path, const std::string& bytes) {
 }
 
 }  // namespace
+
+TEST_CASE("textures: a progressive JPEG of more than 500 scans is refused (issue 28)",
+          "[textures]") {
+  // 7 * 64 = 448 scans decode; 8 * 64 = 512 are past libjpeg-turbo's limit of 500 (a valid
+  // file of 2,080 scans of a larger image took 15 s and 991 MB before TJFLAG_LIMITSCANS).
+  const std::string fine = progressive_jpeg(6);
+  const covrast::RgbaImage image =
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(fine.data()), fine.size(), "j");
+  REQUIRE(image.width == 8);
+  REQUIRE(image.height == 8);
+  CHECK(int(image.rgba[0]) == Approx(128).margin(1));
+  const std::string many = progressive_jpeg(7);
+  REQUIRE_THROWS_WITH(
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(many.data()), many.size(),
+                            "many.jpg"),
+      "many.jpg: cannot decode image: Progressive JPEG image has more than 500 scans");
+}
 
 TEST_CASE("textures: PNG and JPEG decoded by content, from files, data URIs and buffer views",
           "[textures]") {
@@ -629,6 +722,39 @@ TEST_CASE("textures: KHR_texture_transform and texCoord are read per slot", "[te
   REQUIRE(m.metallic_roughness_texture.texture->linear(0, 0, 0).r == Approx(200 / 255.0));
 }
 
+TEST_CASE("textures: KHR_texture_transform fields of a wrong type or range (issue 28)",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(2, 2, 200));
+  const auto load = [&](const nlohmann::json& transform) {
+    nlohmann::json extra;
+    extra["materials"] = {
+        {{"pbrMetallicRoughness",
+          {{"baseColorTexture",
+            {{"index", 0}, {"extensions", {{"KHR_texture_transform", transform}}}}}}}}};
+    write_file(dir / "t.gltf", textured_gltf("t.png", extra));
+    return covrast::load_mesh(dir / "t.gltf");
+  };
+  const std::string where = "t.gltf: material 0 baseColorTexture: ";
+  // texCoord 1e30 was converted to int first (undefined; "texCoord -2147483648").
+  REQUIRE_THROWS_WITH(load({{"texCoord", 1e30}}),
+                      Contains(where + "texCoord 1e+30 (covrast reads TEXCOORD_0 and TEXCOORD_1)"));
+  REQUIRE_THROWS_WITH(load({{"texCoord", -1e30}}), Contains(where + "texCoord -1e+30 ("));
+  REQUIRE_THROWS_WITH(load({{"texCoord", 0.5}}), Contains(where + "texCoord 0.5 ("));
+  REQUIRE_THROWS_WITH(load({{"texCoord", "1"}}),
+                      Contains(where + "KHR_texture_transform.texCoord: expected an integer >= 0"));
+  // Wrong types were ignored silently; the transform is used, so each is an error.
+  REQUIRE_THROWS_WITH(load({{"offset", "0.5"}}),
+                      Contains(where + "KHR_texture_transform.offset: expected an array of 2 "
+                                       "numbers"));
+  REQUIRE_THROWS_WITH(load({{"scale", {1, 2, 3}}}),
+                      Contains(where + "KHR_texture_transform.scale: expected an array of 2"));
+  REQUIRE_THROWS_WITH(load({{"rotation", {1}}}),
+                      Contains(where + "KHR_texture_transform.rotation: expected a number"));
+  REQUIRE(load({{"texCoord", 1.0}, {"rotation", 0.25}})->materials[0].base_color_texture.texcoord ==
+          1);
+}
+
 TEST_CASE("textures: bad images are InputErrors naming the image and the model", "[textures]") {
   covrast::test::TempDir dir("covrast-textures");
   const auto load = [&](const std::string& uri) {
@@ -660,6 +786,121 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
                       Contains("image 0 (text.png)") && Contains("neither PNG nor JPEG"));
   REQUIRE_THROWS_WITH(load("data:image/png;base64," + covrast::test::base64("garbage!")),
                       Contains("m.gltf: image 0"));
+  // Issue 28: a wrong CRC on the last IDAT chunk decoded without a word.
+  std::string bad_crc = png_bytes(4, 4, 40);
+  const std::size_t iend = bad_crc.size() - 12;
+  bad_crc[iend - 1] = char(bad_crc[iend - 1] ^ 1);
+  write_file(dir / "crc.png", bad_crc);
+  REQUIRE_THROWS_WITH(load("crc.png"),
+                      Contains("m.gltf: image 0 (crc.png): cannot decode image: invalid "
+                               "chunk checksum"));
+}
+
+TEST_CASE("textures: an indexed PNG's index past its palette is an error (issue 28)",
+          "[textures]") {
+  // Two entries (red, green), alpha 128 for the first; indices 0, 1, then 5: libspng looked
+  // index 5 up without a word.
+  const std::string palette("\xFF\x00\x00\x00\xFF\x00", 6);
+  const std::string good = indexed_png(std::string("\x00\x01", 2), palette, "\x80");
+  const covrast::RgbaImage image = covrast::decode_image(
+      reinterpret_cast<const std::uint8_t*>(good.data()), good.size(), "p.png");
+  REQUIRE(image.width == 2);
+  CHECK(std::vector<int>(image.rgba.begin(), image.rgba.end()) ==
+        std::vector<int>{255, 0, 0, 128, 0, 255, 0, 255});
+  const std::string bad = indexed_png(std::string("\x00\x01\x05", 3), palette, "");
+  REQUIRE_THROWS_WITH(
+      covrast::decode_image(reinterpret_cast<const std::uint8_t*>(bad.data()), bad.size(), "p.png"),
+      "p.png: cannot decode image: palette index 5 at (2, 0) is past the "
+      "palette's 2 entries");
+}
+
+TEST_CASE("textures: image URIs with a NUL, data: URIs of other media types (issue 28)",
+          "[textures]") {
+  covrast::test::TempDir dir("covrast-textures");
+  const auto load = [&](const std::string& uri) {
+    write_file(dir / "m.gltf", textured_gltf(uri));
+    return covrast::load_mesh(dir / "m.gltf");
+  };
+  write_file(dir / "t.png", png_bytes(2, 2, 40));
+  REQUIRE(load("t.png")->materials[0].base_color_texture.texture->levels[0].width == 2);
+  // "%00" decodes to a NUL: the part before it ("t.png") was opened, exit 0.
+  REQUIRE_THROWS_WITH(load("t.png%00.jpg"),
+                      Contains("m.gltf: image 0 (t.png%00.jpg): the path contains a NUL byte"));
+  // tinygltf takes a data: URI of a media type it does not know for a file name.
+  const std::string png = covrast::test::base64(png_bytes(2, 2, 40));
+  REQUIRE_THROWS_WITH(
+      load("data:text/html;base64," + png),
+      Contains("m.gltf: image 0: data: URI of media type 'text/html' (expected image/png, "
+               "image/jpeg or application/octet-stream)"));
+  REQUIRE_THROWS_WITH(
+      load("data:image/gif;base64," + png),
+      Contains("m.gltf: image 0: data: URI of media type 'image/gif' (expected image/png, "
+               "image/jpeg or application/octet-stream)"));
+  // Accepted, and decoded by their content.
+  for (const char* type : {"image/png", "image/jpeg", "application/octet-stream"}) {
+    INFO(type);
+    const auto mesh = load("data:" + std::string(type) + ";base64," + png);
+    REQUIRE(mesh->materials[0].base_color_texture.texture->levels[0].width == 2);
+  }
+}
+
+TEST_CASE("textures: image entries naming one file are decoded once (issue 28)", "[textures]") {
+  // Eight image entries naming one PNG were eight decoded copies (with a 2^26-pixel PNG of
+  // 196 KB: 3.45 GB from a 3.6 KB glTF). The same file, or buffer view, is decoded once.
+  covrast::test::TempDir dir("covrast-textures");
+  write_file(dir / "t.png", png_bytes(4, 4, 90));
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+  const int uv = b.add_floats({0, 0, 1, 0, 1, 1}, "VEC2");
+  const int view = b.add_view(png_bytes(4, 4, 90));
+  nlohmann::json primitives = nlohmann::json::array();
+  for (int i = 0; i < 8; ++i) {
+    primitives.push_back(
+        {{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", i}});
+    b.gltf["materials"].push_back(
+        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", i}}}}}});
+    b.gltf["textures"].push_back({{"source", i}});
+    if (i < 4) {
+      b.gltf["images"].push_back({{"uri", i % 2 == 0 ? "t.png" : "./t.png"}});
+    } else {
+      b.gltf["images"].push_back({{"bufferView", view}, {"mimeType", "image/png"}});
+    }
+  }
+  b.single_mesh(primitives);
+  write_file(dir / "m.gltf", b.gltf_text());
+  const auto mesh = covrast::load_mesh(dir / "m.gltf");
+  REQUIRE(mesh->materials.size() >= 8);
+  for (int i = 1; i < 8; ++i) {
+    INFO(i);
+    CHECK(mesh->materials[std::size_t(i)].base_color_texture.texture ==
+          mesh->materials[i < 4 ? 0 : 4].base_color_texture.texture);
+  }
+  CHECK(mesh->materials[0].base_color_texture.texture !=
+        mesh->materials[4].base_color_texture.texture);
+}
+
+TEST_CASE("textures: an image file over 1 GiB is refused from its size, unread (issue 28)",
+          "[textures]") {
+  // A sparse file of 1 GiB + 1 byte: it was read in full before its size was checked.
+  covrast::test::TempDir dir("covrast-textures");
+  const std::filesystem::path big = dir / "big.png";
+  write_file(big, "");
+  std::filesystem::resize_file(big, (std::uintmax_t(1) << 30) + 1);
+  const auto start = std::chrono::steady_clock::now();
+  REQUIRE_THROWS_WITH(covrast::read_image(big, "big.png"),
+                      "big.png: cannot read image: file of 1073741825 bytes is larger than the "
+                      "1 GiB limit");
+  write_file(dir / "m.gltf", textured_gltf("big.png"));
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "m.gltf"),
+                      Contains("m.gltf: image 0 (big.png): cannot read image: file of "
+                               "1073741825 bytes is larger than the 1 GiB limit"));
+  write_file(dir / "m.mtl", "newmtl a\nmap_Kd big.png\n");
+  write_file(dir / "m.obj",
+             "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\nf 1/1 2/1 3/1\n");
+  REQUIRE_THROWS_WITH(covrast::load_mesh(dir / "m.obj"),
+                      Contains("m.obj: map_Kd big.png: cannot read image: file of 1073741825 "
+                               "bytes is larger than the 1 GiB limit"));
+  CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < 2.0);
 }
 
 TEST_CASE("textures: OBJ vt lines become corner UVs, v flipped to glTF's orientation",
@@ -785,13 +1026,21 @@ TEST_CASE("textures: TEXCOORD as normalized integers, a missing UV set is a warn
 TEST_CASE("textures: load_texture_file, the hook for OBJ map_Kd", "[textures]") {
   covrast::test::TempDir dir("covrast-textures");
   write_file(dir / "k.png", png_bytes(3, 2, 64));
+  std::uint64_t texels = 0;
   const auto texture =
-      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true);
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true, texels);
   REQUIRE(texture->levels[0].width == 3);
   REQUIRE(texture->linear(0, 0, 0).g == Approx(srgb_decode(64)).epsilon(1e-12));
+  REQUIRE(texels == 6);
   REQUIRE_THROWS_WITH(
-      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true),
+      covrast::detail::load_texture_file(dir / "no.png", "m.obj: map_Kd no.png", true, texels),
       Contains("m.obj: map_Kd no.png: cannot read image"));
+  // The file's decoded images together stay within kMaxTextureTexels (issue 28).
+  texels = covrast::detail::kMaxTextureTexels - 5;
+  REQUIRE_THROWS_WITH(
+      covrast::detail::load_texture_file(dir / "k.png", "m.obj: map_Kd k.png", true, texels),
+      "m.obj: map_Kd k.png: its 3x2 texels take the file's decoded images past 134217728 "
+      "texels (docs/limits.md)");
 }
 
 TEST_CASE("textures: the base colour texture's alpha multiplies into BLEND and MASK",

@@ -4,9 +4,12 @@
 #include "commands.hpp"
 #include "golden_results.hpp"
 
+#include <covrast/error.hpp>
+
 #include <nlohmann/json.hpp>
 
 #include <sstream>
+#include <system_error>
 
 namespace covrast::cli {
 namespace {
@@ -216,9 +219,15 @@ std::string summary_json(const std::vector<CaseResult>& results, const RunSummar
   return out.dump();
 }
 
+void make_directories(const std::filesystem::path& dir) {
+  std::error_code ec;
+  std::filesystem::create_directories(dir, ec);
+  if (ec) throw InputError(dir.string() + ": cannot create the directory: " + ec.message());
+}
+
 void write_html_report(const std::filesystem::path& dir, const Manifest& manifest,
                        const std::vector<CaseResult>& results, const RunSummary& summary) {
-  std::filesystem::create_directories(dir);
+  make_directories(dir);
   std::ostringstream html;
   html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>covrast "
           "test: "

@@ -47,5 +47,8 @@ std::string summary_json(const std::vector<CaseResult>& results, const RunSummar
 /// with golden, actual and heat map side by side and a zoom, then the rest in a table.
 void write_html_report(const std::filesystem::path& dir, const Manifest& manifest,
                        const std::vector<CaseResult>& results, const RunSummary& summary);
+/// create_directories, but a path that cannot be a directory (a regular file is there, or
+/// above it) is an InputError naming it (exit 2), not a filesystem_error (exit 1).
+void make_directories(const std::filesystem::path& dir);
 
 }  // namespace covrast::cli

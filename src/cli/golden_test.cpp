@@ -209,7 +209,7 @@ void update_goldens(const std::vector<PlannedCase>& plans, std::vector<CaseResul
     if (r.status == CaseStatus::Skipped) continue;
     if (r.status == CaseStatus::Passed && !args.all) continue;
     Image image = r.actual.width > 0 ? r.actual : render(*plans[i].scene, plans[i].options).color;
-    std::filesystem::create_directories(r.test->golden.parent_path());
+    make_directories(r.test->golden.parent_path());
     write_png(image, r.test->golden,
               {{kRecordKeyword, record_of(plans[i], build, image.width, image.height)}});
     std::cout << "updated " << r.test->name << ": " << r.test->golden.string() << " ("
@@ -235,7 +235,7 @@ void print_results(const std::vector<CaseResult>& results, const RunSummary& sum
 }
 
 void write_artifacts(const std::filesystem::path& dir, const std::vector<CaseResult>& results) {
-  std::filesystem::create_directories(dir);
+  make_directories(dir);
   for (const CaseResult& r : results) {
     if (r.actual.width == 0) continue;
     const std::string base = safe_file_name(r.test->name);

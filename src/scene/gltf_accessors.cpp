@@ -9,6 +9,7 @@
 #include <bit>
 #include <cmath>
 #include <cstring>
+#include <sstream>
 
 namespace covrast::detail {
 namespace {
@@ -85,6 +86,19 @@ double read_component(const unsigned char* bytes, int component_type, bool norma
 
 void fail(const std::string& name, const std::string& message) {
   throw InputError(name + ": " + message);
+}
+
+std::optional<int> whole_number(const tinygltf::Value& value, int lo, int hi) {
+  if (!value.IsNumber()) return std::nullopt;
+  const double x = value.GetNumberAsDouble();
+  if (!(x >= double(lo) && x <= double(hi)) || std::floor(x) != x) return std::nullopt;
+  return static_cast<int>(x);
+}
+
+std::string number_text(double value) {
+  std::ostringstream text;
+  text << value;
+  return text.str();
 }
 
 /// `text` with every byte outside printable ASCII shown as '?' (messages are one line).
@@ -195,6 +209,11 @@ std::vector<double> GltfReader::read_accessor(const std::string& what, int acces
     for (std::size_t i = 0; i < sparse_count; ++i) {
       const auto target = static_cast<std::size_t>(targets[i]);
       if (target >= accessor.count) fail(name, what + ": sparse index out of range");
+      // glTF 2.0, 3.6.2.3: the indices strictly increase (issue 28: unsorted ones were taken).
+      if (i > 0 && !(targets[i] > targets[i - 1])) {
+        fail(name, what + ": sparse indices must strictly increase (" +
+                       number_text(targets[i - 1]) + " then " + number_text(targets[i]) + ")");
+      }
       std::copy_n(replacements.begin() + static_cast<std::ptrdiff_t>(i * width), width,
                   values.begin() + static_cast<std::ptrdiff_t>(target * width));
     }

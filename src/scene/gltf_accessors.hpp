@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,15 @@ inline constexpr std::size_t kMaxVertices = std::numeric_limits<std::uint32_t>::
 
 /// `text` with every byte outside printable ASCII shown as '?' (messages are one line).
 std::string printable(std::string text);
+
+/// A JSON number of the file (a tinygltf Value, integer or real) as a whole number in
+/// [lo, hi], or nullopt when it is not a number, not whole, or outside: compared as a double
+/// before it is converted, since a double outside int's range converted to int is undefined
+/// (a KHR_texture_transform texCoord of 1e30 was).
+std::optional<int> whole_number(const tinygltf::Value& value, int lo, int hi);
+
+/// A number for a message: as short as it prints ("3", "1e+30", "-1.5").
+std::string number_text(double value);
 
 /// The accessors of `model`, read for messages that start with `name` (the file).
 struct GltfReader {

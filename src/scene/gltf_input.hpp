@@ -16,9 +16,11 @@ namespace covrast::detail {
 /// Throws InputError("name: ...") when `bytes` are neither glTF JSON nor binary glTF, nest
 /// deeper than kMaxJsonDepth, hold a number beyond double's range, give a field covrast reads
 /// the wrong JSON type (an array where an object belongs, a string for a number, a negative
-/// index or count), or name a buffer that cannot be read as its byteLength says.
+/// index or count), or name a buffer that cannot be read as its byteLength says. A
+/// KHR_lights_punctual range that is not > 0 is an error for a point or spot light and a
+/// line of `warn` (tinygltf's warnings) for a directional one, which has no range.
 void check_gltf_input(std::string_view bytes, const std::string& name,
-                      const std::filesystem::path& base_dir);
+                      const std::filesystem::path& base_dir, std::string& warn);
 
 /// tinygltf's file access: FileExists without opening (a FIFO would block), no path
 /// expansion, ReadWholeFile through read_whole_file (regular files up to kMaxInputFileBytes).

@@ -127,9 +127,13 @@ std::vector<glm::dmat4> vertex_skin_matrices(const std::vector<SkinInfluences>& 
   for (const SkinInfluences& set : sets) {
     for (std::size_t i = 0; i < 4 * vertex_count; ++i) {
       if (set.weights[i] == 0.0) continue;
-      if (!(set.joints[i] < static_cast<double>(joints.size()))) {
-        fail(name, what + ": joint " + std::to_string(static_cast<std::uint64_t>(set.joints[i])) +
-                       " out of range (" + std::to_string(joints.size()) + " joints)");
+      // Checked as a double before the conversion: a Draco stream's joint numbers are not
+      // bound by the accessor's component type, and a negative or non-finite number converted
+      // to an index is undefined.
+      const double joint = set.joints[i];
+      if (!(joint >= 0.0 && joint < static_cast<double>(joints.size()))) {
+        fail(name, what + ": joint " + number_text(joint) + " out of range (" +
+                       std::to_string(joints.size()) + " joints)");
       }
       skin[i / 4] += set.weights[i] * joints[static_cast<std::size_t>(set.joints[i])];
     }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string_view>
 
 namespace covrast::detail {
@@ -11,6 +12,10 @@ namespace covrast::detail {
 bool keep_image_bytes(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
                       const unsigned char* bytes, int size, void*) {
   if (image->bufferView >= 0) return true;  // read from the view, bounds-checked (decode())
+  // An image file (tinygltf keeps its uri, not a data: URI's): read again by decode() when a
+  // material uses it, once per distinct file, rather than a copy kept per image entry (eight
+  // entries naming one file were eight copies, issue 28).
+  if (!image->uri.empty()) return true;
   image->image.assign(bytes, bytes + size);
   image->as_is = true;
   return true;
@@ -46,6 +51,34 @@ TextureWrap wrap_mode(int code) {
   return TextureWrap::Repeat;
 }
 
+/// glTF 2.0, 5.26: the sampler's enums are these codes (or absent: -1 for the filters). A
+/// sampler a material uses with any other code is an error (issue 28: they were taken for
+/// the defaults without a word).
+void check_sampler(const tinygltf::Sampler& s, const std::string& name, const std::string& what) {
+  const auto wrap = [](int code) {
+    return code == TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE ||
+           code == TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT || code == TINYGLTF_TEXTURE_WRAP_REPEAT;
+  };
+  if (s.magFilter != -1 && s.magFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+      s.magFilter != TINYGLTF_TEXTURE_FILTER_LINEAR) {
+    fail(name, what + ": magFilter " + std::to_string(s.magFilter) +
+                   " is not 9728 (NEAREST) or 9729 (LINEAR)");
+  }
+  if (s.minFilter != -1 && s.minFilter != TINYGLTF_TEXTURE_FILTER_NEAREST &&
+      s.minFilter != TINYGLTF_TEXTURE_FILTER_LINEAR &&
+      !(s.minFilter >= TINYGLTF_TEXTURE_FILTER_NEAREST_MIPMAP_NEAREST &&
+        s.minFilter <= TINYGLTF_TEXTURE_FILTER_LINEAR_MIPMAP_LINEAR)) {
+    fail(name,
+         what + ": minFilter " + std::to_string(s.minFilter) + " is not 9728, 9729 or 9984..9987");
+  }
+  if (!wrap(s.wrapS) || !wrap(s.wrapT)) {
+    fail(name, what + ": " +
+                   (wrap(s.wrapS) ? "wrapT " + std::to_string(s.wrapT)
+                                  : "wrapS " + std::to_string(s.wrapS)) +
+                   " is not 33071, 33648 or 10497");
+  }
+}
+
 TextureSampler sampler_of(const tinygltf::Sampler& s) {
   TextureSampler out;
   out.wrap_s = wrap_mode(s.wrapS);
@@ -75,27 +108,53 @@ TextureSampler sampler_of(const tinygltf::Sampler& s) {
   return out;
 }
 
-double number_or(const tinygltf::Value& object, const char* key, double fallback) {
-  if (!object.Has(key) || !object.Get(key).IsNumber()) return fallback;
-  const double v = object.Get(key).GetNumberAsDouble();
-  return std::isfinite(v) ? v : fallback;
+/// KHR_texture_transform's number `key` of `object`, `fallback` when absent; any other type
+/// is an error (the schema says number: tinygltf would hand over anything).
+double number_or(const tinygltf::Value& object, const char* key, double fallback,
+                 const std::string& name, const std::string& where) {
+  if (!object.Has(key)) return fallback;
+  const tinygltf::Value& v = object.Get(key);
+  if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble())) {
+    fail(name, where + "." + key + ": expected a number");
+  }
+  return v.GetNumberAsDouble();
 }
 
-glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fallback) {
+/// KHR_texture_transform's pair `key` (offset, scale): an array of two numbers, or absent.
+glm::dvec2 pair_or(const tinygltf::Value& object, const char* key, glm::dvec2 fallback,
+                   const std::string& name, const std::string& where) {
   if (!object.Has(key)) return fallback;
   const tinygltf::Value& a = object.Get(key);
-  if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber()) {
-    return fallback;
+  if (!a.IsArray() || a.ArrayLen() != 2 || !a.Get(0).IsNumber() || !a.Get(1).IsNumber() ||
+      !std::isfinite(a.Get(0).GetNumberAsDouble()) ||
+      !std::isfinite(a.Get(1).GetNumberAsDouble())) {
+    fail(name, where + "." + key + ": expected an array of 2 numbers");
   }
-  const glm::dvec2 v(a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble());
-  return std::isfinite(v.x) && std::isfinite(v.y) ? v : fallback;
+  return {a.Get(0).GetNumberAsDouble(), a.Get(1).GetNumberAsDouble()};
 }
+
+/// The media types of a glTF image's data: URI that covrast reads.
+constexpr std::string_view kImageDataUriTypes =
+    "expected image/png, image/jpeg or application/octet-stream";
 
 }  // namespace
 
+void count_texture_texels(int width, int height, const std::string& name,
+                          std::uint64_t& texels_used) {
+  const std::uint64_t texels = std::uint64_t(width) * std::uint64_t(height);
+  if (texels > kMaxTextureTexels - texels_used) {
+    throw InputError(name + ": its " + std::to_string(width) + "x" + std::to_string(height) +
+                     " texels take the file's decoded images past " +
+                     std::to_string(kMaxTextureTexels) + " texels (docs/limits.md)");
+  }
+  texels_used += texels;
+}
+
 std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
-                                                 const std::string& name, bool srgb) {
+                                                 const std::string& name, bool srgb,
+                                                 std::uint64_t& texels_used) {
   RgbaImage image = read_image(path, name);
+  count_texture_texels(image.width, image.height, name, texels_used);
   return make_texture(name, image.width, image.height, std::move(image.rgba), srgb);
 }
 
@@ -105,10 +164,39 @@ RgbaImage GltfTextures::decode(const tinygltf::Image& image, const std::string& 
     const std::size_t size = model_.bufferViews[std::size_t(image.bufferView)].byteLength;
     return decode_image(bytes, size, image_name);
   }
-  if (!image.image.empty()) return decode_image(image.image.data(), image.image.size(), image_name);
-  // tinygltf could not read the file (it only warns): read it here for the reason.
+  if (!image.image.empty()) {
+    // A data: URI tinygltf decoded; it names the media types it knows in mimeType (none for
+    // application/octet-stream). Only PNG and JPEG are read, by their content.
+    if (!image.mimeType.empty() && image.mimeType != "image/png" &&
+        image.mimeType != "image/jpeg") {
+      throw InputError(image_name + ": data: URI of media type '" + printable(image.mimeType) +
+                       "' (" + std::string(kImageDataUriTypes) + ")");
+    }
+    return decode_image(image.image.data(), image.image.size(), image_name);
+  }
   if (image.uri.empty()) throw InputError(image_name + ": no image data");
-  return read_image(base_dir_ / percent_decoded(image.uri), image_name);
+  // A data: URI of a media type tinygltf does not decode, which it takes for a file name.
+  if (image.uri.rfind("data:", 0) == 0) {
+    const std::size_t end = image.uri.find_first_of(";,", 5);
+    throw InputError(image_name + ": data: URI of media type '" +
+                     printable(image.uri.substr(5, std::min<std::size_t>(end, 60) - 5)) + "' (" +
+                     std::string(kImageDataUriTypes) + ")");
+  }
+  // An image file: read here (tinygltf's copy is not kept, keep_image_bytes), its size checked
+  // before it is read. A %00 escape would otherwise open the path before the NUL.
+  const std::string path = percent_decoded(image.uri);
+  if (path.find('\0') != std::string::npos) {
+    throw InputError(image_name + ": the path contains a NUL byte");
+  }
+  return read_image(base_dir_ / path, image_name);
+}
+
+std::string GltfTextures::source_key(int image_index, const tinygltf::Image& image) const {
+  if (image.bufferView >= 0) return "view " + std::to_string(image.bufferView);
+  if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0) {
+    return "file " + (base_dir_ / percent_decoded(image.uri)).lexically_normal().string();
+  }
+  return "image " + std::to_string(image_index);
 }
 
 std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool srgb,
@@ -125,10 +213,20 @@ std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool
   } else if (!image.name.empty()) {
     image_name += " (" + printable(image.name) + ")";
   }
+  // Image entries that name the same file or buffer view share one decoded texture.
+  const auto source = std::make_pair(source_key(image_index, image), srgb);
+  if (const auto it = by_source_.find(source); it != by_source_.end()) {
+    textures_.emplace(key, it->second);
+    return it->second;
+  }
   // The decoded bytes become level 0 (moved, not copied): nothing else keeps them.
   RgbaImage rgba = decode(image, image_name);
+  // The file's decoded images together stay within kMaxTextureTexels, checked before this
+  // one's mipmaps are built (docs/limits.md).
+  count_texture_texels(rgba.width, rgba.height, image_name, texels_);
   auto texture = make_texture(image_name, rgba.width, rgba.height, std::move(rgba.rgba), srgb);
   textures_.emplace(key, texture);
+  by_source_.emplace(source, texture);
   return texture;
 }
 
@@ -145,21 +243,35 @@ TextureSlot GltfTextures::slot(int texture_index, int texcoord,
     if (std::size_t(texture.sampler) >= model_.samplers.size()) {
       fail(reader_.name, what + ": sampler " + std::to_string(texture.sampler) + " does not exist");
     }
-    out.sampler = sampler_of(model_.samplers[std::size_t(texture.sampler)]);
+    const tinygltf::Sampler& sampler = model_.samplers[std::size_t(texture.sampler)];
+    check_sampler(sampler, reader_.name, what + ": sampler " + std::to_string(texture.sampler));
+    out.sampler = sampler_of(sampler);
   }
   out.texcoord = texcoord;
   // KHR_texture_transform on the textureInfo: offset, rotation, scale, texCoord override.
-  if (const auto it = extensions.find("KHR_texture_transform");
-      it != extensions.end() && it->second.IsObject()) {
+  // Each field of a wrong type is an error: the transform is used (issue 28).
+  const std::string texcoord_range = " (covrast reads TEXCOORD_0 and TEXCOORD_1)";
+  if (const auto it = extensions.find("KHR_texture_transform"); it != extensions.end()) {
     const tinygltf::Value& t = it->second;
-    out.transform.offset = pair_or(t, "offset", glm::dvec2(0.0));
-    out.transform.rotation = number_or(t, "rotation", 0.0);
-    out.transform.scale = pair_or(t, "scale", glm::dvec2(1.0));
-    out.texcoord = int(number_or(t, "texCoord", double(texcoord)));
+    const std::string where = what + ": KHR_texture_transform";
+    if (!t.IsObject()) fail(reader_.name, where + ": expected an object");
+    out.transform.offset = pair_or(t, "offset", glm::dvec2(0.0), reader_.name, where);
+    out.transform.rotation = number_or(t, "rotation", 0.0, reader_.name, where);
+    out.transform.scale = pair_or(t, "scale", glm::dvec2(1.0), reader_.name, where);
+    if (t.Has("texCoord")) {
+      // Range-checked as a double before it becomes an int (1e30 was undefined behaviour).
+      const tinygltf::Value& set = t.Get("texCoord");
+      if (!set.IsNumber()) fail(reader_.name, where + ".texCoord: expected an integer >= 0");
+      const std::optional<int> index = whole_number(set, 0, kMaxTexcoordSets - 1);
+      if (!index) {
+        fail(reader_.name,
+             what + ": texCoord " + number_text(set.GetNumberAsDouble()) + texcoord_range);
+      }
+      out.texcoord = *index;
+    }
   }
   if (out.texcoord < 0 || out.texcoord >= kMaxTexcoordSets) {
-    fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) +
-                           " (covrast reads TEXCOORD_0 and TEXCOORD_1)");
+    fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) + texcoord_range);
   }
   out.texture = image_texture(texture.source, srgb, what);
   return out;

@@ -10,6 +10,7 @@
 
 #include <tiny_gltf.h>
 
+#include <cstdint>
 #include <filesystem>
 #include <map>
 #include <memory>
@@ -41,11 +42,15 @@ class GltfTextures {
                    bool srgb, const std::string& what);
   std::shared_ptr<const Texture> image_texture(int image_index, bool srgb, const std::string& what);
   RgbaImage decode(const tinygltf::Image& image, const std::string& image_name) const;
+  /// What identifies an image's bytes: its buffer view, its file, or else the entry itself.
+  std::string source_key(int image_index, const tinygltf::Image& image) const;
 
   const tinygltf::Model& model_;
   const GltfReader& reader_;
   std::filesystem::path base_dir_;
   std::map<std::pair<int, bool>, std::shared_ptr<const Texture>> textures_;
+  std::map<std::pair<std::string, bool>, std::shared_ptr<const Texture>> by_source_;
+  std::uint64_t texels_ = 0;  ///< level-0 texels of the textures decoded so far
 };
 
 }  // namespace covrast::detail

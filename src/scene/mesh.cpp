@@ -24,8 +24,12 @@ std::string size_text(std::uint64_t bytes) {
   return std::to_string(bytes) + " bytes";
 }
 
-bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
-                     std::uint64_t max_bytes) {
+namespace {
+
+/// read_whole_file into a std::string or a byte vector.
+template <class Buffer>
+bool read_whole_file_into(const std::filesystem::path& path, Buffer& contents, std::string& error,
+                          std::uint64_t max_bytes) {
   const auto system_error = [&](int code) {
     error = std::error_code(code, std::generic_category()).message();
     return false;
@@ -68,6 +72,18 @@ bool read_whole_file(const std::filesystem::path& path, std::string& contents, s
   }
   contents.resize(done);
   return true;
+}
+
+}  // namespace
+
+bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
+                     std::uint64_t max_bytes) {
+  return read_whole_file_into(path, contents, error, max_bytes);
+}
+
+bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned char>& contents,
+                     std::string& error, std::uint64_t max_bytes) {
+  return read_whole_file_into(path, contents, error, max_bytes);
 }
 
 std::size_t drop_nonfinite_triangles(MeshData& mesh) {

@@ -199,7 +199,7 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
 /// covrast's decoder, never by stb_image); its message on failure.
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                            const std::filesystem::path& base_dir, std::string& warn) {
-  check_gltf_input(bytes, name, base_dir);
+  check_gltf_input(bytes, name, base_dir, warn);
   const std::optional<std::string> rewritten = without_draco_indices(bytes);
   if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
@@ -302,6 +302,14 @@ class GltfMeshBuilder {
         fail(name, "material " + std::to_string(i) + ": alphaMode \"" + mode +
                        "\" is not OPAQUE, MASK or BLEND");
       }
+      // glTF 2.0, 5.19: alphaCutoff >= 0. Used in MASK mode: an error; else ignored: a
+      // warning (issue 28: -1 was taken as 0).
+      if (const double cutoff = model.materials[i].alphaCutoff; !(cutoff >= 0.0)) {
+        const std::string message = "material " + std::to_string(i) + ": alphaCutoff " +
+                                    number_text(cutoff) + " must be >= 0";
+        if (mode == "MASK") fail(name, message);
+        warnings_.push_back(name + ": " + message + " (ignored: alphaMode is " + mode + ")");
+      }
       mesh_->materials.push_back(convert_material(model.materials[i]));
       textures.apply(model.materials[i], int(i), mesh_->materials.back());
     }
@@ -329,6 +337,7 @@ class GltfMeshBuilder {
     if (const std::string undrawn = undrawn_primitives_message(); !undrawn.empty()) {
       loaded.warnings.push_back(undrawn);
     }
+    loaded.warnings.insert(loaded.warnings.end(), warnings_.begin(), warnings_.end());
     if (missing_texcoords_ > 0) {
       loaded.warnings.push_back(name_ + ": " + std::to_string(missing_texcoords_) +
                                 " primitives lack the TEXCOORD_n their material's textures use; "
@@ -481,7 +490,38 @@ class GltfMeshBuilder {
         fail(name_, what + ": JOINTS" + suffix + " and WEIGHTS" + suffix +
                         " must both be VEC4 with one value per vertex");
       }
+      check_skin_component_types(source.primitive, suffix, what);
       sets.push_back({std::move(*joints), std::move(*weights)});
+    }
+  }
+
+  /// glTF 2.0, 3.7.3.3: JOINTS_n are unsigned bytes or shorts, WEIGHTS_n floats or normalized
+  /// unsigned bytes or shorts. Any other type (a float or signed joint number) is an error
+  /// naming the accessor, before a joint number is used as an index.
+  void check_skin_component_types(const tinygltf::Primitive& primitive, const std::string& suffix,
+                                  const std::string& what) const {
+    const tinygltf::Accessor* joints = attribute_accessor(primitive, "JOINTS" + suffix);
+    const tinygltf::Accessor* weights = attribute_accessor(primitive, "WEIGHTS" + suffix);
+    const auto unsigned_integer = [](int type) {
+      return type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE ||
+             type == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+    };
+    if (joints != nullptr && (!unsigned_integer(joints->componentType) || joints->normalized)) {
+      fail(name_, what + ": JOINTS" + suffix + " (accessor " +
+                      std::to_string(primitive.attributes.at("JOINTS" + suffix)) +
+                      ") has component type " + std::to_string(joints->componentType) +
+                      (joints->normalized ? " normalized" : "") +
+                      ": joints must be UNSIGNED_BYTE (5121) or UNSIGNED_SHORT (5123)");
+    }
+    if (weights != nullptr &&
+        !(weights->componentType == TINYGLTF_COMPONENT_TYPE_FLOAT ||
+          (unsigned_integer(weights->componentType) && weights->normalized))) {
+      fail(name_, what + ": WEIGHTS" + suffix + " (accessor " +
+                      std::to_string(primitive.attributes.at("WEIGHTS" + suffix)) +
+                      ") has component type " + std::to_string(weights->componentType) +
+                      (weights->normalized ? " normalized" : "") +
+                      ": weights must be FLOAT (5126) or normalized UNSIGNED_BYTE (5121) or "
+                      "UNSIGNED_SHORT (5123)");
     }
   }
 
@@ -892,6 +932,7 @@ class GltfMeshBuilder {
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   bool any_normals_ = false;
   std::size_t missing_texcoords_ = 0;  ///< primitives sampling a UV set they lack
+  std::vector<std::string> warnings_;  ///< spec violations in what covrast does not use
   std::vector<FileCamera> cameras_;
   std::vector<FileLight> lights_;       ///< KHR_lights_punctual, in walk order
   std::vector<glm::dmat4> node_world_;  ///< per node: its transform to the file's world space

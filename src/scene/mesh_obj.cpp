@@ -192,6 +192,7 @@ class ObjParser {
   /// materials naming it; a missing or undecodable image is an InputError naming it.
   void load_color_maps(MeshData& mesh, LoadedMesh& loaded) const {
     std::map<std::string, std::shared_ptr<const Texture>> maps;
+    std::uint64_t texels = 0;  // of the file's decoded maps, within kMaxTextureTexels
     std::size_t without_uvs = 0;
     for (Material& m : mesh.materials) {
       if (m.base_color_texture_path.empty()) continue;
@@ -201,7 +202,7 @@ class ObjParser {
         const std::filesystem::path path(m.base_color_texture_path);
         std::string shown = path.lexically_relative(base_dir_).string();
         if (shown.empty()) shown = path.filename().string();
-        texture = load_texture_file(path, name_ + ": map_Kd " + printable(shown), true);
+        texture = load_texture_file(path, name_ + ": map_Kd " + printable(shown), true, texels);
       }
       m.base_color_texture.texture = texture;
       without_uvs += any_face_uv_ ? 0 : 1;

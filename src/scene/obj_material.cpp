@@ -7,6 +7,7 @@
 #include "scene/obj_text.hpp"
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <optional>
 
@@ -114,14 +115,51 @@ class MtlParser {
     return c;
   }
 
-  /// "map_Kd [options] file": the file is the last token (options such as -s u v w come
-  /// before it), resolved against the .mtl file's directory.
+  /// "map_Kd [options] file": the options of the MTL format come first, each with its values
+  /// (-o, -s and -t take one to three numbers, -mm two, the others one); the rest of the line
+  /// is the file name, spaces included ("my tex.png", issue 28: the last token was taken),
+  /// resolved against the .mtl file's directory.
   void texture(Tokens& tokens) {
-    std::string_view token, last;
-    while (tokens.next(token)) last = token;
-    if (last.empty()) fail_at(name_, line_no_, "map_Kd: expected a file name");
+    static constexpr std::array<std::pair<std::string_view, int>, 12> kOptions = {{
+        {"-blendu", 1},
+        {"-blendv", 1},
+        {"-bm", 1},
+        {"-boost", 1},
+        {"-cc", 1},
+        {"-clamp", 1},
+        {"-imfchan", 1},
+        {"-mm", 2},
+        {"-o", 3},
+        {"-s", 3},
+        {"-t", 3},
+        {"-texres", 1},
+    }};
+    for (;;) {
+      Tokens ahead = tokens;
+      std::string_view option;
+      if (!ahead.next(option)) break;
+      const auto known = std::find_if(kOptions.begin(), kOptions.end(),
+                                      [&](const auto& o) { return o.first == option; });
+      if (known == kOptions.end()) break;  // the file name (which may start with '-')
+      tokens = ahead;
+      const bool vector = known->first == "-o" || known->first == "-s" || known->first == "-t";
+      for (int k = 0; k < known->second; ++k) {
+        Tokens value_ahead = tokens;
+        std::string_view value;
+        double number = 0.0;
+        if (!value_ahead.next(value)) {
+          fail_at(name_, line_no_,
+                  "map_Kd: option " + std::string(known->first) + " needs a value");
+        }
+        // -o, -s and -t: u, then v and w when they are numbers.
+        if (vector && k > 0 && !parse_double(value, number)) break;
+        tokens = value_ahead;
+      }
+    }
+    const std::string_view file = tokens.rest();
+    if (file.empty()) fail_at(name_, line_no_, "map_Kd: expected a file name");
     current_->material.base_color_texture_path =
-        (directory_ / std::filesystem::path(std::string(last))).lexically_normal().string();
+        (directory_ / std::filesystem::path(std::string(file))).lexically_normal().string();
   }
 
   /// The entry read so far: its shading model from illum and Ks, then into the library.
@@ -137,11 +175,7 @@ class MtlParser {
     } else {
       m.model = ShadingModel::BlinnPhong;
     }
-    if (const long found = library_.find(current_->name); found >= 0) {
-      library_.materials[static_cast<std::size_t>(found)] = std::move(*current_);
-    } else {
-      library_.materials.push_back(std::move(*current_));
-    }
+    library_.add(std::move(*current_));
     current_.reset();
     has_d_ = false;
     has_ks_ = false;
@@ -162,10 +196,17 @@ class MtlParser {
 }  // namespace
 
 long MtlLibrary::find(std::string_view name) const {
-  for (std::size_t i = 0; i < materials.size(); ++i) {
-    if (materials[i].name == name) return static_cast<long>(i);
+  const auto it = index_.find(std::string(name));
+  return it == index_.end() ? -1 : static_cast<long>(it->second);
+}
+
+void MtlLibrary::add(ObjMaterial material) {
+  const auto [it, added] = index_.try_emplace(material.name, materials.size());
+  if (added) {
+    materials.push_back(std::move(material));
+  } else {
+    materials[it->second] = std::move(material);
   }
-  return -1;
 }
 
 void parse_mtl(std::string_view text, const std::string& display_name,

@@ -11,6 +11,7 @@
 #include <filesystem>
 #include <string>
 #include <string_view>
+#include <unordered_map>
 #include <vector>
 
 namespace covrast::detail {
@@ -28,8 +29,14 @@ struct ObjMaterial {
 struct MtlLibrary {
   std::vector<ObjMaterial> materials;
   std::vector<std::string> warnings;
-  /// The index of material `name` in `materials`, or -1.
+  /// The index of material `name` in `materials`, or -1. A hash lookup: a file of 100,000
+  /// newmtl or usemtl statements must not cost 100,000 scans of the materials (issue 28).
   long find(std::string_view name) const;
+  /// Adds `material`, or replaces the one of its name.
+  void add(ObjMaterial material);
+
+ private:
+  std::unordered_map<std::string, std::size_t> index_;  ///< name -> position in `materials`
 };
 
 /// Reads one .mtl file's text into `library`. `display_name` prefixes every message

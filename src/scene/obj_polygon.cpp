@@ -1,9 +1,11 @@
 // OBJ polygons to triangles. A convex polygon keeps the fan (0, k, k + 1) that covrast has
 // always used (so that existing meshes load to the same triangles); a concave one is ear-clipped
-// (Meisters 1975, "Polygons have ears"; the O(n^2)-per-ear form of Eberly, "Triangulation by
-// Ear Clipping", 2002) in the plane it is flattest in: the coordinate plane orthogonal to the
-// largest component of its Newell normal (Newell's method, Sutherland, Sproull and Schumacker
-// 1974: N = sum_i (p_i - p_{i+1}) x ... componentwise, see newell_normal). All in double.
+// (Meisters 1975, "Polygons have ears"; the O(n)-per-ear-test form of Eberly, "Triangulation by
+// Ear Clipping", 2002, with each corner's blocking corner remembered so that a failed test is
+// not repeated: O(n^2) in all) in the plane it is flattest in: the coordinate plane orthogonal
+// to the largest component of its Newell normal (Newell's method, Sutherland, Sproull and
+// Schumacker 1974: N = sum_i (p_i - p_{i+1}) x ... componentwise, see newell_normal). All in
+// double.
 #include "scene/obj_polygon.hpp"
 
 #include <cmath>
@@ -92,6 +94,14 @@ bool clip_ears(const std::vector<glm::dvec2>& p, std::vector<std::uint32_t>& out
     prev[i] = static_cast<std::uint32_t>((i + n - 1) % n);
     next[i] = static_cast<std::uint32_t>((i + 1) % n);
   }
+  // Per corner, the remaining corner last found in or on its triangle and the neighbours it
+  // had then: while the neighbours are the same and that corner has not been clipped, the
+  // same point lies in the same triangle, so the corner is still no ear and is not scanned
+  // again. The result is the same as scanning every time; without this, the rounds that find
+  // no ear rescan all corners and a 4096-corner face took seconds (issue 28).
+  constexpr std::uint32_t kNone = 0xffffffffu;
+  std::vector<std::uint32_t> witness(n, kNone), witness_prev(n), witness_next(n);
+  std::vector<bool> clipped(n, false);
   std::vector<std::uint32_t> triangles;
   std::size_t remaining = n;
   std::uint32_t b = 0;
@@ -101,16 +111,28 @@ bool clip_ears(const std::vector<glm::dvec2>& p, std::vector<std::uint32_t>& out
     const double turn = orient(p[a], p[b], p[c]);
     bool ear = turn == 0.0;
     if (turn > 0.0) {
-      ear = true;
+      const std::uint32_t w = witness[b];
+      ear = !(w != kNone && !clipped[w] && witness_prev[b] == a && witness_next[b] == c);
+      // A point in or on the triangle lies in its bounding box: the box is the cheap test.
+      const glm::dvec2 lo = glm::min(p[a], glm::min(p[b], p[c]));
+      const glm::dvec2 hi = glm::max(p[a], glm::max(p[b], p[c]));
       for (std::uint32_t q = next[c]; q != a && ear; q = next[q]) {
-        if (p[q] == p[a] || p[q] == p[b] || p[q] == p[c]) continue;
-        ear = !inside_or_on(p[q], p[a], p[b], p[c]);
+        const glm::dvec2& pq = p[q];
+        if (pq.x < lo.x || pq.x > hi.x || pq.y < lo.y || pq.y > hi.y) continue;
+        if (pq == p[a] || pq == p[b] || pq == p[c]) continue;
+        if (inside_or_on(p[q], p[a], p[b], p[c])) {
+          ear = false;
+          witness[b] = q;
+          witness_prev[b] = a;
+          witness_next[b] = c;
+        }
       }
     }
     if (ear) {
       triangles.insert(triangles.end(), {a, b, c});
       next[a] = c;
       prev[c] = a;
+      clipped[b] = true;
       --remaining;
       tried = 0;
       b = c;

@@ -62,6 +62,9 @@ struct LoadedMesh {
 /// file", a size over the limit, a NUL byte in the path). Never blocks on a FIFO or device.
 bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
                      std::uint64_t max_bytes = kMaxInputFileBytes);
+/// The same into bytes (tinygltf's buffers and images: read once, not copied).
+bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned char>& contents,
+                     std::string& error, std::uint64_t max_bytes = kMaxInputFileBytes);
 
 /// "1 GiB", "64 MiB" or "N bytes".
 std::string size_text(std::uint64_t bytes);
@@ -86,10 +89,22 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
 /// An image file as a texture (docs/textures.md): read_image, then make_texture with `srgb`
 /// (true for colour maps: glTF baseColor and emissive, OBJ map_Kd). `name` names it in
 /// messages, e.g. "model.obj: map_Kd wood.png". Throws InputError when it is missing or
-/// cannot be decoded. The hook for OBJ materials: each distinct map_Kd path of a file loaded
+/// cannot be decoded, or when it takes `texels_used` (the file's so far) past
+/// kMaxTextureTexels. The hook for OBJ materials: each distinct map_Kd path of a file loaded
 /// once, its Texture shared by the materials that name it.
 std::shared_ptr<const Texture> load_texture_file(const std::filesystem::path& path,
-                                                 const std::string& name, bool srgb);
+                                                 const std::string& name, bool srgb,
+                                                 std::uint64_t& texels_used);
+
+/// Level-0 texels of the decoded images of one mesh file (glTF images, OBJ map_Kd), all
+/// together: 2^27, two of the largest images (kMaxPngPixels), 512 MiB as RGBA8. Checked as
+/// each image is decoded, before its mipmaps are built (docs/limits.md).
+inline constexpr std::uint64_t kMaxTextureTexels = std::uint64_t(1) << 27;
+
+/// Adds a decoded image of width x height to `texels_used`, the texels of the file's images
+/// so far; throws InputError("name: ...") when that passes kMaxTextureTexels.
+void count_texture_texels(int width, int height, const std::string& name,
+                          std::uint64_t& texels_used);
 
 /// load_mesh_scene's camera for a file without one (scene_auto.cpp): looking down -z at the
 /// centre of the world box of the scene's meshes from the distance where the box's bounding
