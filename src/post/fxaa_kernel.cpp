@@ -1,0 +1,332 @@
+// Post-process stage, FXAA: the SIMD row kernels (fxaa_kernel.hpp), one source compiled for
+// every Highway target; the best is picked at run time. Each lane does the scalar twin's IEEE
+// operations in its order (fxaa_kernel_scalar.cpp), so every target gives the same bits:
+//   - luma row: N pixels per vector (LoadInterleaved3 of the bytes, int32 sums, one division);
+//   - filter row: the contrast test on N pixels per vector (plain loads inside the row, clamped
+//     gathers at its ends), the passing pixels' x compressed into a list; then the list N
+//     candidates per vector: the 3x3 block, direction and sub-pixel weight, both searches
+//     along the edge (bilinear fetches by gather, a lane stopping when its own search ends,
+//     the vector when all have), the blend in linear light and the exact sRGB encode by
+//     gathers from encode_srgb8's tables.
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "post/fxaa_kernel.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+#include "core/srgb8.hpp"
+#include "post/fxaa_kernel.hpp"
+
+#include <algorithm>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+
+HWY_BEFORE_NAMESPACE();
+namespace covrast::detail::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+using DF = hn::ScalableTag<float>;
+using DI = hn::RebindToSigned<DF>;
+using VF = hn::Vec<DF>;
+using VI = hn::Vec<DI>;
+using MF = hn::Mask<DF>;
+
+/// Most float lanes of any target (2048-bit vectors): the slack of the stack buffers below.
+constexpr int kMaxLanes = 64;
+
+/// std::max(a, b) and std::min(a, b) lane by lane: a < b ? b : a and b < a ? b : a (the
+/// max and min instructions pick differently between +0 and -0).
+HWY_INLINE VF StdMax(VF a, VF b) { return hn::IfThenElse(hn::Lt(a, b), b, a); }
+HWY_INLINE VF StdMin(VF a, VF b) { return hn::IfThenElse(hn::Lt(b, a), b, a); }
+
+HWY_INLINE VI Clamp(VI v, VI lo, VI hi) { return hn::Min(hn::Max(v, lo), hi); }
+
+/// luma = float(299 r + 587 g + 114 b) / 255000 for N pixels at `rgb`.
+HWY_INLINE VF LumaOf(const std::uint8_t* HWY_RESTRICT rgb) {
+  const DF df;
+  const DI di;
+  const hn::Rebind<std::uint8_t, DF> d8;
+  hn::Vec<decltype(d8)> r, g, b;
+  hn::LoadInterleaved3(d8, rgb, r, g, b);
+  const VI weighted = hn::Add(hn::Add(hn::Mul(hn::Set(di, 299), hn::PromoteTo(di, r)),
+                                      hn::Mul(hn::Set(di, 587), hn::PromoteTo(di, g))),
+                              hn::Mul(hn::Set(di, 114), hn::PromoteTo(di, b)));
+  return hn::Div(hn::ConvertTo(df, weighted), hn::Set(df, 255000.0f));
+}
+
+void LumaRow(const std::uint8_t* HWY_RESTRICT rgb, int width, float* HWY_RESTRICT luma) {
+  const DF df;
+  const int n = int(hn::Lanes(df));
+  int x = 0;
+  for (; x + n <= width; x += n) hn::StoreU(LumaOf(rgb + 3 * std::size_t(x)), df, luma + x);
+  if (x < width) {
+    // The last pixels through a buffer, so that no load or store leaves the row.
+    std::uint8_t bytes[3 * kMaxLanes] = {};
+    HWY_ALIGN float out[kMaxLanes];
+    const int rest = width - x;
+    std::memcpy(bytes, rgb + 3 * std::size_t(x), 3 * std::size_t(rest));
+    hn::Store(LumaOf(bytes), df, out);
+    std::memcpy(luma + x, out, sizeof(float) * std::size_t(rest));
+  }
+}
+
+/// Step 1 on N pixels: the range of the cross > 0 and >= max(edge_threshold_min,
+/// max * edge_threshold).
+HWY_INLINE MF Passes(VF m, VF n, VF s, VF w, VF e, VF edge_threshold_min, VF edge_threshold) {
+  const DF df;
+  const VF max_luma = StdMax(StdMax(StdMax(m, n), StdMax(s, w)), e);
+  const VF range = hn::Sub(max_luma, StdMin(StdMin(StdMin(m, n), StdMin(s, w)), e));
+  const VF needed = StdMax(edge_threshold_min, hn::Mul(max_luma, edge_threshold));
+  return hn::And(hn::Gt(range, hn::Zero(df)), hn::Ge(range, needed));
+}
+
+/// The rows a filter row reads, and the frame's bounds as vectors.
+struct RowView {
+  const float* above;
+  const float* row;
+  const float* below;
+  int y;
+};
+
+/// encode_srgb8 lane by lane, from its tables.
+HWY_INLINE VI EncodeSrgb8(VF x, const Srgb8EncodeTables& tables) {
+  const DF df;
+  const DI di;
+  const MF inside = hn::And(hn::Gt(x, hn::Zero(df)), hn::Lt(x, hn::Set(df, 1.0f)));
+  // Lanes outside (0, 1) look up bucket 0 and are replaced below.
+  const VF xin = hn::IfThenElseZero(inside, x);
+  VI code = hn::GatherIndex(di, tables.start,
+                            hn::ConvertTo(di, hn::Mul(xin, hn::Set(df, float(kSrgb8Buckets)))));
+  for (;;) {
+    const MF step = hn::And(inside, hn::Le(hn::GatherIndex(df, tables.threshold, code), xin));
+    if (hn::AllFalse(df, step)) break;
+    code = hn::Sub(code, hn::VecFromMask(di, hn::RebindMask(di, step)));  // + 1 where stepping
+  }
+  const VI zero = hn::Zero(di);
+  return hn::IfThenElse(hn::RebindMask(di, hn::Ge(x, hn::Set(df, 1.0f))), hn::Set(di, 255),
+                        hn::IfThenElse(hn::RebindMask(di, inside), code, zero));
+}
+
+/// Steps 2 to 5 for the candidates xs (valid lanes: `valid`; the others hold x = 0) of row y.
+HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const RowView& rv, VI xs,
+                                MF valid, const Srgb8EncodeTables& tables,
+                                std::uint8_t* HWY_RESTRICT out) {
+  const DF df;
+  const DI di;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), two = hn::Set(df, 2.0f);
+  const VF half = hn::Set(df, 0.5f);
+  const VI izero = hn::Zero(di), ione = hn::Set(di, 1);
+  const VI wmax = hn::Set(di, f.width - 1), hmax = hn::Set(di, f.height - 1);
+  const VI width = hn::Set(di, f.width);
+
+  // The 3x3 block, columns clamped to the frame (the rows are, in rv).
+  const VI left = hn::Max(hn::Sub(xs, ione), izero);
+  const VI right = hn::Min(hn::Add(xs, ione), wmax);
+  const VF m = hn::GatherIndex(df, rv.row, xs);
+  const VF n = hn::GatherIndex(df, rv.above, xs);
+  const VF s = hn::GatherIndex(df, rv.below, xs);
+  const VF w = hn::GatherIndex(df, rv.row, left);
+  const VF e = hn::GatherIndex(df, rv.row, right);
+  const VF nw = hn::GatherIndex(df, rv.above, left);
+  const VF ne = hn::GatherIndex(df, rv.above, right);
+  const VF sw = hn::GatherIndex(df, rv.below, left);
+  const VF se = hn::GatherIndex(df, rv.below, right);
+  const VF range = hn::Sub(StdMax(StdMax(StdMax(m, n), StdMax(s, w)), e),
+                           StdMin(StdMin(StdMin(m, n), StdMin(s, w)), e));
+
+  // Step 2: horz = |nw + sw - 2w| + 2 |n + s - 2m| + |ne + se - 2e|, vert likewise.
+  const VF horz = hn::Add(hn::Add(hn::Abs(hn::Sub(hn::Add(nw, sw), hn::Mul(two, w))),
+                                  hn::Mul(two, hn::Abs(hn::Sub(hn::Add(n, s), hn::Mul(two, m))))),
+                          hn::Abs(hn::Sub(hn::Add(ne, se), hn::Mul(two, e))));
+  const VF vert = hn::Add(hn::Add(hn::Abs(hn::Sub(hn::Add(nw, ne), hn::Mul(two, n))),
+                                  hn::Mul(two, hn::Abs(hn::Sub(hn::Add(w, e), hn::Mul(two, m))))),
+                          hn::Abs(hn::Sub(hn::Add(sw, se), hn::Mul(two, s))));
+  const MF horizontal = hn::Ge(horz, vert);
+
+  // Step 3: lowpass = (2 (n + s + w + e) + (nw + ne + sw + se)) * (1/12),
+  // c = min(1, |lowpass - m| / range), weight = (c c (3 - 2 c))^2 * subpix.
+  const VF lowpass = hn::Mul(hn::Add(hn::Mul(two, hn::Add(hn::Add(hn::Add(n, s), w), e)),
+                                     hn::Add(hn::Add(hn::Add(nw, ne), sw), se)),
+                             hn::Set(df, 1.0f / 12.0f));
+  const VF c = StdMin(one, hn::Div(hn::Abs(hn::Sub(lowpass, m)), range));
+  const VF smooth = hn::Mul(hn::Mul(c, c), hn::Sub(hn::Set(df, 3.0f), hn::Mul(two, c)));
+  const VF subpix = hn::Mul(hn::Mul(smooth, smooth), hn::Set(df, p.subpix));
+
+  // Across the edge: before (n or w) or after (s or e), the larger luma step.
+  const VF before = hn::IfThenElse(horizontal, n, w);
+  const VF after = hn::IfThenElse(horizontal, s, e);
+  const VF step_before = hn::Abs(hn::Sub(before, m));
+  const VF step_after = hn::Abs(hn::Sub(after, m));
+  const MF to_before = hn::Ge(step_before, step_after);
+  const VF gradient = StdMax(step_before, step_after);
+  const VF side = hn::IfThenElse(to_before, hn::Set(df, -1.0f), one);
+  const VF edge_mean = hn::Mul(half, hn::Add(hn::IfThenElse(to_before, before, after), m));
+
+  // Step 4: bilinear samples half a pixel across the edge, `along` it from the pixel.
+  const VF xf = hn::ConvertTo(df, xs);
+  const VF yf = hn::Set(df, float(rv.y));
+  const VF half_side = hn::Mul(half, side);
+  const VF u_across = hn::Add(xf, half_side), v_across = hn::Add(yf, half_side);
+  const auto sample = [&](VF along) HWY_ATTR {
+    const VF u = hn::IfThenElse(horizontal, hn::Add(xf, along), u_across);
+    const VF v = hn::IfThenElse(horizontal, v_across, hn::Add(yf, along));
+    const VF x0 = hn::Floor(u), y0 = hn::Floor(v);
+    const VF fx = hn::Sub(u, x0), fy = hn::Sub(v, y0);
+    const VI ix = hn::ConvertTo(di, x0), iy = hn::ConvertTo(di, y0);
+    const VI col0 = Clamp(ix, izero, wmax), col1 = Clamp(hn::Add(ix, ione), izero, wmax);
+    const VI row0 = hn::Mul(Clamp(iy, izero, hmax), width);
+    const VI row1 = hn::Mul(Clamp(hn::Add(iy, ione), izero, hmax), width);
+    const VF top =
+        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row0, col0))),
+                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row0, col1))));
+    const VF bottom =
+        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row1, col0))),
+                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row1, col1))));
+    return hn::Sub(hn::Add(hn::Mul(hn::Sub(one, fy), top), hn::Mul(fy, bottom)), edge_mean);
+  };
+  const VF limit = hn::Mul(hn::Set(df, 0.25f), gradient);
+  VF back_distance = hn::Set(df, p.steps[0]), ahead_distance = back_distance;
+  VF back_luma = sample(hn::Neg(back_distance)), ahead_luma = sample(ahead_distance);
+  MF back_on = valid, ahead_on = valid;
+  for (int k = 1; k < p.step_count; ++k) {
+    back_on = hn::AndNot(hn::Ge(hn::Abs(back_luma), limit), back_on);
+    ahead_on = hn::AndNot(hn::Ge(hn::Abs(ahead_luma), limit), ahead_on);
+    if (hn::AllFalse(df, hn::Or(back_on, ahead_on))) break;
+    const VF step = hn::Set(df, p.steps[k]);
+    back_distance = hn::IfThenElse(back_on, hn::Add(back_distance, step), back_distance);
+    ahead_distance = hn::IfThenElse(ahead_on, hn::Add(ahead_distance, step), ahead_distance);
+    if (k + 1 < p.step_count) {
+      back_luma = hn::IfThenElse(back_on, sample(hn::Neg(back_distance)), back_luma);
+      ahead_luma = hn::IfThenElse(ahead_on, sample(ahead_distance), ahead_luma);
+    }
+  }
+
+  // The nearer end decides: 0.5 - distance / span where the span is good.
+  const MF centre_below = hn::Lt(hn::Sub(m, edge_mean), zero);
+  const MF back_nearer = hn::Lt(back_distance, ahead_distance);
+  const VF nearer_distance = hn::IfThenElse(back_nearer, back_distance, ahead_distance);
+  const VF nearer_luma = hn::IfThenElse(back_nearer, back_luma, ahead_luma);
+  const MF good_span = hn::Xor(hn::Lt(nearer_luma, zero), centre_below);
+  const VF span_offset =
+      hn::Sub(half, hn::Div(nearer_distance, hn::Add(back_distance, ahead_distance)));
+  const VF weight = StdMax(hn::IfThenElseZero(good_span, span_offset), subpix);
+  const MF blend = hn::And(valid, hn::Ne(weight, zero));
+  if (hn::AllFalse(df, blend)) return;
+
+  // Step 5: the partner across the edge, clamped to the frame.
+  const VI step = hn::IfThenElse(hn::RebindMask(di, to_before), hn::Set(di, -1), ione);
+  const VI horizontal_i = hn::VecFromMask(di, hn::RebindMask(di, horizontal));
+  const VI ox = Clamp(hn::Add(xs, hn::AndNot(horizontal_i, step)), izero, wmax);
+  const VI oy = Clamp(hn::Add(hn::Set(di, rv.y), hn::And(horizontal_i, step)), izero, hmax);
+  HWY_ALIGN std::int32_t centre_index[kMaxLanes], other_index[kMaxLanes];
+  hn::Store(hn::Add(hn::Mul(hn::Set(di, rv.y), width), xs), di, centre_index);
+  hn::Store(hn::Add(hn::Mul(oy, width), ox), di, other_index);
+  // The bytes of both pixels, channel-major, as int32 (there is no byte gather).
+  HWY_ALIGN std::int32_t bytes[6][kMaxLanes];
+  const int lanes = int(hn::Lanes(df));
+  for (int i = 0; i < lanes; ++i) {
+    const std::uint8_t* centre = f.rgb + 3 * std::size_t(centre_index[i]);
+    const std::uint8_t* other = f.rgb + 3 * std::size_t(other_index[i]);
+    for (int ch = 0; ch < 3; ++ch) {
+      bytes[ch][i] = centre[ch];
+      bytes[3 + ch][i] = other[ch];
+    }
+  }
+  const float* linear = fxaa_srgb8_linear();
+  const VF keep = hn::Sub(one, weight);
+  HWY_ALIGN std::int32_t code[3][kMaxLanes];
+  for (int ch = 0; ch < 3; ++ch) {
+    const VF a = hn::GatherIndex(df, linear, hn::Load(di, bytes[ch]));
+    const VF b = hn::GatherIndex(df, linear, hn::Load(di, bytes[3 + ch]));
+    hn::Store(EncodeSrgb8(hn::Add(hn::Mul(keep, a), hn::Mul(weight, b)), tables), di, code[ch]);
+  }
+  HWY_ALIGN std::int32_t x_of[kMaxLanes], write[kMaxLanes];
+  hn::Store(xs, di, x_of);
+  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, blend)), di, write);
+  for (int i = 0; i < lanes; ++i) {
+    if (write[i] == 0) continue;
+    std::uint8_t* dst = out + 3 * std::size_t(x_of[i]);
+    dst[0] = std::uint8_t(code[0][i]);
+    dst[1] = std::uint8_t(code[1][i]);
+    dst[2] = std::uint8_t(code[2][i]);
+  }
+}
+
+void FilterRow(const FxaaFrame& f, const FxaaParams& p, int y, std::uint8_t* HWY_RESTRICT out) {
+  const DF df;
+  const DI di;
+  const int n = int(hn::Lanes(df));
+  const int width = f.width;
+  const RowView rv{f.luma + std::size_t(std::max(y - 1, 0)) * width,
+                   f.luma + std::size_t(y) * width,
+                   f.luma + std::size_t(std::min(y + 1, f.height - 1)) * width, y};
+  const VF edge_threshold = hn::Set(df, p.edge_threshold);
+  const VF edge_threshold_min = hn::Set(df, p.edge_threshold_min);
+  const VI izero = hn::Zero(di), ione = hn::Set(di, 1), wmax = hn::Set(di, width - 1);
+  const Srgb8EncodeTables tables = srgb8_encode_tables();
+  const VI iota = hn::Iota(di, 0);  // built once: Iota goes through memory on some targets
+
+  // The row in chunks: the candidates' x of a chunk, then their blends.
+  constexpr int kChunk = 256;
+  HWY_ALIGN std::int32_t candidates[kChunk + kMaxLanes];
+  for (int x0 = 0; x0 < width; x0 += kChunk) {
+    const int x1 = std::min(x0 + kChunk, width);
+    int count = 0;
+    for (int x = x0; x < x1; x += n) {
+      const VI xs = hn::Add(iota, hn::Set(di, x));
+      VF m, north, south, west, east;
+      if (x >= 1 && x + n < width) {
+        // Inside the row: every lane's neighbours are in it.
+        m = hn::LoadU(df, rv.row + x);
+        north = hn::LoadU(df, rv.above + x);
+        south = hn::LoadU(df, rv.below + x);
+        west = hn::LoadU(df, rv.row + x - 1);
+        east = hn::LoadU(df, rv.row + x + 1);
+      } else {
+        // At the row's ends: clamped gathers (lanes past the end read the last pixel).
+        const VI c = hn::Min(xs, wmax);
+        m = hn::GatherIndex(df, rv.row, c);
+        north = hn::GatherIndex(df, rv.above, c);
+        south = hn::GatherIndex(df, rv.below, c);
+        west = hn::GatherIndex(df, rv.row, hn::Max(hn::Sub(c, ione), izero));
+        east = hn::GatherIndex(df, rv.row, hn::Min(hn::Add(c, ione), wmax));
+      }
+      const MF pass =
+          hn::And(hn::FirstN(df, std::size_t(x1 - x)),
+                  Passes(m, north, south, west, east, edge_threshold_min, edge_threshold));
+      // Most vectors have no candidate. Compress in a register, then store: the masked
+      // compressing store is microcoded on some CPUs (AMD Zen 4), tens of times slower.
+      if (hn::AllFalse(df, pass)) continue;
+      const auto pass_i = hn::RebindMask(di, pass);
+      hn::StoreU(hn::Compress(xs, pass_i), di, candidates + count);
+      count += int(hn::CountTrue(di, pass_i));
+    }
+    // Lanes past the last candidate read x = 0 (and are not written).
+    hn::StoreU(izero, di, candidates + count);
+    for (int k = 0; k < count; k += n) {
+      BlendCandidates(f, p, rv, hn::LoadU(di, candidates + k),
+                      hn::FirstN(df, std::size_t(count - k)), tables, out);
+    }
+  }
+}
+
+}  // namespace covrast::detail::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace covrast::detail {
+
+HWY_EXPORT(LumaRow);
+HWY_EXPORT(FilterRow);
+
+FxaaKernels fxaa_kernels_simd() {
+  // HWY_DYNAMIC_DISPATCH's first table entry is an initialising trampoline, so make the
+  // choice first.
+  hwy::ChosenTarget& chosen = hwy::GetChosenTarget();
+  if (!chosen.IsInitialized()) chosen.Update(hwy::SupportedTargets());
+  const std::size_t index = chosen.GetIndex();
+  return FxaaKernels{HWY_DISPATCH_TABLE(LumaRow)[index], HWY_DISPATCH_TABLE(FilterRow)[index]};
+}
+
+}  // namespace covrast::detail
+#endif  // HWY_ONCE
