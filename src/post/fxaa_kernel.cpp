@@ -17,6 +17,7 @@
 #include "post/fxaa_kernel.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
@@ -28,8 +29,13 @@ namespace hn = hwy::HWY_NAMESPACE;
 using DF = hn::ScalableTag<float>;
 using DI = hn::RebindToSigned<DF>;
 using VF = hn::Vec<DF>;
+using DU = hn::RebindToUnsigned<DF>;
 using VI = hn::Vec<DI>;
+using VU = hn::Vec<DU>;
 using MF = hn::Mask<DF>;
+
+// PixelBytes reads a pixel's bytes as one little-endian word.
+static_assert(std::endian::native == std::endian::little);
 
 /// Most float lanes of any target (2048-bit vectors): the slack of the stack buffers below.
 constexpr int kMaxLanes = 64;
@@ -105,6 +111,31 @@ HWY_INLINE VI EncodeSrgb8(VF x, const Srgb8EncodeTables& tables) {
   const VI zero = hn::Zero(di);
   return hn::IfThenElse(hn::RebindMask(di, hn::Ge(x, hn::Set(df, 1.0f))), hn::Set(di, 255),
                         hn::IfThenElse(hn::RebindMask(di, inside), code, zero));
+}
+
+/// The 3 bytes of each lane's pixel (an index into the frame) in the low 24 bits: one 32-bit
+/// gather at byte 3 p, or at 3 p - 1 (then shifted) for the frame's last pixel, so that no
+/// read leaves the buffer. The frame has at least 2 pixels (a 1-pixel frame has no
+/// candidate: its cross is flat).
+HWY_INLINE VU PixelBytes(const FxaaFrame& f, VI pixel) {
+  const DI di;
+  const DU du;
+  const hn::Mask<DI> last = hn::Eq(pixel, hn::Set(di, f.width * f.height - 1));
+  const VI offset =
+      hn::Sub(hn::Add(hn::Add(pixel, pixel), pixel), hn::IfThenElseZero(last, hn::Set(di, 1)));
+  const VU word =
+      hn::BitCast(du, hn::GatherOffset(di, reinterpret_cast<const std::int32_t*>(f.rgb), offset));
+  return hn::IfThenElse(hn::RebindMask(du, last), hn::ShiftRight<8>(word), word);
+}
+
+/// Channel `ch` (0..2) of PixelBytes, as an index.
+HWY_INLINE VI Channel(VU bytes, int ch) {
+  const DI di;
+  const DU du;
+  const VU shifted = ch == 0   ? bytes
+                     : ch == 1 ? hn::ShiftRight<8>(bytes)
+                               : hn::ShiftRight<16>(bytes);
+  return hn::BitCast(di, hn::And(shifted, hn::Set(du, 0xFFu)));
 }
 
 /// Steps 2 to 5 for the candidates xs (valid lanes: `valid`; the others hold x = 0) of row y.
@@ -218,28 +249,17 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const R
   const VI horizontal_i = hn::VecFromMask(di, hn::RebindMask(di, horizontal));
   const VI ox = Clamp(hn::Add(xs, hn::AndNot(horizontal_i, step)), izero, wmax);
   const VI oy = Clamp(hn::Add(hn::Set(di, rv.y), hn::And(horizontal_i, step)), izero, hmax);
-  HWY_ALIGN std::int32_t centre_index[kMaxLanes], other_index[kMaxLanes];
-  hn::Store(hn::Add(hn::Mul(hn::Set(di, rv.y), width), xs), di, centre_index);
-  hn::Store(hn::Add(hn::Mul(oy, width), ox), di, other_index);
-  // The bytes of both pixels, channel-major, as int32 (there is no byte gather).
-  HWY_ALIGN std::int32_t bytes[6][kMaxLanes];
-  const int lanes = int(hn::Lanes(df));
-  for (int i = 0; i < lanes; ++i) {
-    const std::uint8_t* centre = f.rgb + 3 * std::size_t(centre_index[i]);
-    const std::uint8_t* other = f.rgb + 3 * std::size_t(other_index[i]);
-    for (int ch = 0; ch < 3; ++ch) {
-      bytes[ch][i] = centre[ch];
-      bytes[3 + ch][i] = other[ch];
-    }
-  }
+  const VU centre = PixelBytes(f, hn::Add(hn::Mul(hn::Set(di, rv.y), width), xs));
+  const VU other = PixelBytes(f, hn::Add(hn::Mul(oy, width), ox));
   const float* linear = fxaa_srgb8_linear();
   const VF keep = hn::Sub(one, weight);
   HWY_ALIGN std::int32_t code[3][kMaxLanes];
   for (int ch = 0; ch < 3; ++ch) {
-    const VF a = hn::GatherIndex(df, linear, hn::Load(di, bytes[ch]));
-    const VF b = hn::GatherIndex(df, linear, hn::Load(di, bytes[3 + ch]));
+    const VF a = hn::GatherIndex(df, linear, Channel(centre, ch));
+    const VF b = hn::GatherIndex(df, linear, Channel(other, ch));
     hn::Store(EncodeSrgb8(hn::Add(hn::Mul(keep, a), hn::Mul(weight, b)), tables), di, code[ch]);
   }
+  const int lanes = int(hn::Lanes(df));
   HWY_ALIGN std::int32_t x_of[kMaxLanes], write[kMaxLanes];
   hn::Store(xs, di, x_of);
   hn::Store(hn::VecFromMask(di, hn::RebindMask(di, blend)), di, write);
