@@ -74,7 +74,7 @@ void fxaa_rows(const Image& input, const LumaPlane& plane, const FxaaOptions& op
                Image& output, int y_begin, int y_end, const FxaaKernels& kernels) {
   const FxaaFrame frame{input.rgb.data(), plane.luma.data(), input.width, input.height};
   const FxaaParams params = fxaa_params(options);
-  for (int y = y_begin; y < y_end; ++y) kernels.filter_row(frame, params, y, output.pixel(0, y));
+  if (y_begin < y_end) kernels.filter_rows(frame, params, y_begin, y_end, output.rgb.data());
 }
 
 Image fxaa(const Image& input, const FxaaOptions& options, const FxaaKernels& kernels) {

@@ -86,14 +86,6 @@ HWY_INLINE MF Passes(VF m, VF n, VF s, VF w, VF e, VF edge_threshold_min, VF edg
   return hn::And(hn::Gt(range, hn::Zero(df)), hn::Ge(range, needed));
 }
 
-/// The rows a filter row reads, and the frame's bounds as vectors.
-struct RowView {
-  const float* above;
-  const float* row;
-  const float* below;
-  int y;
-};
-
 /// encode_srgb8 lane by lane, from its tables.
 HWY_INLINE VI EncodeSrgb8(VF x, const Srgb8EncodeTables& tables) {
   const DF df;
@@ -138,10 +130,10 @@ HWY_INLINE VI Channel(VU bytes, int ch) {
   return hn::BitCast(di, hn::And(shifted, hn::Set(du, 0xFFu)));
 }
 
-/// Steps 2 to 5 for the candidates xs (valid lanes: `valid`; the others hold x = 0) of row y.
-HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const RowView& rv, VI xs,
-                                MF valid, const Srgb8EncodeTables& tables,
-                                std::uint8_t* HWY_RESTRICT out) {
+/// Steps 2 to 5 for the candidates (xs, ys) (valid lanes: `valid`; the others hold pixel
+/// (0, 0)); `out` is the output frame.
+HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, VI xs, VI ys, MF valid,
+                                const Srgb8EncodeTables& tables, std::uint8_t* HWY_RESTRICT out) {
   const DF df;
   const DI di;
   const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), two = hn::Set(df, 2.0f);
@@ -150,18 +142,22 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const R
   const VI wmax = hn::Set(di, f.width - 1), hmax = hn::Set(di, f.height - 1);
   const VI width = hn::Set(di, f.width);
 
-  // The 3x3 block, columns clamped to the frame (the rows are, in rv).
+  // The 3x3 block, clamped to the frame: the rows' first pixels and the columns.
+  const VI row = hn::Mul(ys, width);
+  const VI above = hn::Mul(hn::Max(hn::Sub(ys, ione), izero), width);
+  const VI below = hn::Mul(hn::Min(hn::Add(ys, ione), hmax), width);
   const VI left = hn::Max(hn::Sub(xs, ione), izero);
   const VI right = hn::Min(hn::Add(xs, ione), wmax);
-  const VF m = hn::GatherIndex(df, rv.row, xs);
-  const VF n = hn::GatherIndex(df, rv.above, xs);
-  const VF s = hn::GatherIndex(df, rv.below, xs);
-  const VF w = hn::GatherIndex(df, rv.row, left);
-  const VF e = hn::GatherIndex(df, rv.row, right);
-  const VF nw = hn::GatherIndex(df, rv.above, left);
-  const VF ne = hn::GatherIndex(df, rv.above, right);
-  const VF sw = hn::GatherIndex(df, rv.below, left);
-  const VF se = hn::GatherIndex(df, rv.below, right);
+  const auto at = [&](VI r, VI c) HWY_ATTR { return hn::GatherIndex(df, f.luma, hn::Add(r, c)); };
+  const VF m = at(row, xs);
+  const VF n = at(above, xs);
+  const VF s = at(below, xs);
+  const VF w = at(row, left);
+  const VF e = at(row, right);
+  const VF nw = at(above, left);
+  const VF ne = at(above, right);
+  const VF sw = at(below, left);
+  const VF se = at(below, right);
   const VF range = hn::Sub(StdMax(StdMax(StdMax(m, n), StdMax(s, w)), e),
                            StdMin(StdMin(StdMin(m, n), StdMin(s, w)), e));
 
@@ -195,7 +191,7 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const R
 
   // Step 4: bilinear samples half a pixel across the edge, `along` it from the pixel.
   const VF xf = hn::ConvertTo(df, xs);
-  const VF yf = hn::Set(df, float(rv.y));
+  const VF yf = hn::ConvertTo(df, ys);
   const VF half_side = hn::Mul(half, side);
   const VF u_across = hn::Add(xf, half_side), v_across = hn::Add(yf, half_side);
   const auto sample = [&](VF along) HWY_ATTR {
@@ -248,8 +244,9 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const R
   const VI step = hn::IfThenElse(hn::RebindMask(di, to_before), hn::Set(di, -1), ione);
   const VI horizontal_i = hn::VecFromMask(di, hn::RebindMask(di, horizontal));
   const VI ox = Clamp(hn::Add(xs, hn::AndNot(horizontal_i, step)), izero, wmax);
-  const VI oy = Clamp(hn::Add(hn::Set(di, rv.y), hn::And(horizontal_i, step)), izero, hmax);
-  const VU centre = PixelBytes(f, hn::Add(hn::Mul(hn::Set(di, rv.y), width), xs));
+  const VI oy = Clamp(hn::Add(ys, hn::And(horizontal_i, step)), izero, hmax);
+  const VI pixel = hn::Add(row, xs);
+  const VU centre = PixelBytes(f, pixel);
   const VU other = PixelBytes(f, hn::Add(hn::Mul(oy, width), ox));
   const float* linear = fxaa_srgb8_linear();
   const VF keep = hn::Sub(one, weight);
@@ -260,73 +257,90 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, const R
     hn::Store(EncodeSrgb8(hn::Add(hn::Mul(keep, a), hn::Mul(weight, b)), tables), di, code[ch]);
   }
   const int lanes = int(hn::Lanes(df));
-  HWY_ALIGN std::int32_t x_of[kMaxLanes], write[kMaxLanes];
-  hn::Store(xs, di, x_of);
+  HWY_ALIGN std::int32_t pixel_of[kMaxLanes], write[kMaxLanes];
+  hn::Store(pixel, di, pixel_of);
   hn::Store(hn::VecFromMask(di, hn::RebindMask(di, blend)), di, write);
   for (int i = 0; i < lanes; ++i) {
     if (write[i] == 0) continue;
-    std::uint8_t* dst = out + 3 * std::size_t(x_of[i]);
+    std::uint8_t* dst = out + 3 * std::size_t(pixel_of[i]);
     dst[0] = std::uint8_t(code[0][i]);
     dst[1] = std::uint8_t(code[1][i]);
     dst[2] = std::uint8_t(code[2][i]);
   }
 }
 
-void FilterRow(const FxaaFrame& f, const FxaaParams& p, int y, std::uint8_t* HWY_RESTRICT out) {
+void FilterRows(const FxaaFrame& f, const FxaaParams& p, int y_begin, int y_end,
+                std::uint8_t* HWY_RESTRICT out) {
   const DF df;
   const DI di;
   const int n = int(hn::Lanes(df));
   const int width = f.width;
-  const RowView rv{f.luma + std::size_t(std::max(y - 1, 0)) * width,
-                   f.luma + std::size_t(y) * width,
-                   f.luma + std::size_t(std::min(y + 1, f.height - 1)) * width, y};
   const VF edge_threshold = hn::Set(df, p.edge_threshold);
   const VF edge_threshold_min = hn::Set(df, p.edge_threshold_min);
   const VI izero = hn::Zero(di), ione = hn::Set(di, 1), wmax = hn::Set(di, width - 1);
   const Srgb8EncodeTables tables = srgb8_encode_tables();
   const VI iota = hn::Iota(di, 0);  // built once: Iota goes through memory on some targets
 
-  // The row in chunks: the candidates' x of a chunk, then their blends.
+  // The candidates' (x, y), gathered over the rows in chunks of a row; whole vectors of them
+  // are blended after each chunk, the rest carried over (fewer partly filled vectors: a row
+  // of sphere_grid has a few tens of candidates). Fewer than n are left before a chunk.
   constexpr int kChunk = 256;
-  HWY_ALIGN std::int32_t candidates[kChunk + kMaxLanes];
-  for (int x0 = 0; x0 < width; x0 += kChunk) {
-    const int x1 = std::min(x0 + kChunk, width);
-    int count = 0;
-    for (int x = x0; x < x1; x += n) {
-      const VI xs = hn::Add(iota, hn::Set(di, x));
-      VF m, north, south, west, east;
-      if (x >= 1 && x + n < width) {
-        // Inside the row: every lane's neighbours are in it.
-        m = hn::LoadU(df, rv.row + x);
-        north = hn::LoadU(df, rv.above + x);
-        south = hn::LoadU(df, rv.below + x);
-        west = hn::LoadU(df, rv.row + x - 1);
-        east = hn::LoadU(df, rv.row + x + 1);
-      } else {
-        // At the row's ends: clamped gathers (lanes past the end read the last pixel).
-        const VI c = hn::Min(xs, wmax);
-        m = hn::GatherIndex(df, rv.row, c);
-        north = hn::GatherIndex(df, rv.above, c);
-        south = hn::GatherIndex(df, rv.below, c);
-        west = hn::GatherIndex(df, rv.row, hn::Max(hn::Sub(c, ione), izero));
-        east = hn::GatherIndex(df, rv.row, hn::Min(hn::Add(c, ione), wmax));
+  HWY_ALIGN std::int32_t cand_x[kChunk + 2 * kMaxLanes];
+  HWY_ALIGN std::int32_t cand_y[kChunk + 2 * kMaxLanes];
+  int count = 0;
+  for (int y = y_begin; y < y_end; ++y) {
+    const float* above = f.luma + std::size_t(std::max(y - 1, 0)) * width;
+    const float* row = f.luma + std::size_t(y) * width;
+    const float* below = f.luma + std::size_t(std::min(y + 1, f.height - 1)) * width;
+    const VI yv = hn::Set(di, y);
+    for (int x0 = 0; x0 < width; x0 += kChunk) {
+      const int x1 = std::min(x0 + kChunk, width);
+      for (int x = x0; x < x1; x += n) {
+        const VI xs = hn::Add(iota, hn::Set(di, x));
+        VF m, north, south, west, east;
+        if (x >= 1 && x + n < width) {
+          // Inside the row: every lane's neighbours are in it.
+          m = hn::LoadU(df, row + x);
+          north = hn::LoadU(df, above + x);
+          south = hn::LoadU(df, below + x);
+          west = hn::LoadU(df, row + x - 1);
+          east = hn::LoadU(df, row + x + 1);
+        } else {
+          // At the row's ends: clamped gathers (lanes past the end read the last pixel).
+          const VI c = hn::Min(xs, wmax);
+          m = hn::GatherIndex(df, row, c);
+          north = hn::GatherIndex(df, above, c);
+          south = hn::GatherIndex(df, below, c);
+          west = hn::GatherIndex(df, row, hn::Max(hn::Sub(c, ione), izero));
+          east = hn::GatherIndex(df, row, hn::Min(hn::Add(c, ione), wmax));
+        }
+        const MF pass =
+            hn::And(hn::FirstN(df, std::size_t(x1 - x)),
+                    Passes(m, north, south, west, east, edge_threshold_min, edge_threshold));
+        // Most vectors have no candidate. Compress in a register, then store: the masked
+        // compressing store is microcoded on some CPUs (AMD Zen 4), tens of times slower.
+        if (hn::AllFalse(df, pass)) continue;
+        const auto pass_i = hn::RebindMask(di, pass);
+        hn::StoreU(hn::Compress(xs, pass_i), di, cand_x + count);
+        hn::StoreU(yv, di, cand_y + count);
+        count += int(hn::CountTrue(di, pass_i));
       }
-      const MF pass =
-          hn::And(hn::FirstN(df, std::size_t(x1 - x)),
-                  Passes(m, north, south, west, east, edge_threshold_min, edge_threshold));
-      // Most vectors have no candidate. Compress in a register, then store: the masked
-      // compressing store is microcoded on some CPUs (AMD Zen 4), tens of times slower.
-      if (hn::AllFalse(df, pass)) continue;
-      const auto pass_i = hn::RebindMask(di, pass);
-      hn::StoreU(hn::Compress(xs, pass_i), di, candidates + count);
-      count += int(hn::CountTrue(di, pass_i));
+      int k = 0;
+      for (; k + n <= count; k += n) {
+        BlendCandidates(f, p, hn::LoadU(di, cand_x + k), hn::LoadU(di, cand_y + k),
+                        hn::FirstN(df, std::size_t(n)), tables, out);
+      }
+      std::memmove(cand_x, cand_x + k, sizeof(std::int32_t) * std::size_t(count - k));
+      std::memmove(cand_y, cand_y + k, sizeof(std::int32_t) * std::size_t(count - k));
+      count -= k;
     }
-    // Lanes past the last candidate read x = 0 (and are not written).
-    hn::StoreU(izero, di, candidates + count);
-    for (int k = 0; k < count; k += n) {
-      BlendCandidates(f, p, rv, hn::LoadU(di, candidates + k),
-                      hn::FirstN(df, std::size_t(count - k)), tables, out);
-    }
+  }
+  if (count > 0) {
+    // Lanes past the last candidate read pixel (0, 0) (and are not written).
+    hn::StoreU(izero, di, cand_x + count);
+    hn::StoreU(izero, di, cand_y + count);
+    BlendCandidates(f, p, hn::LoadU(di, cand_x), hn::LoadU(di, cand_y),
+                    hn::FirstN(df, std::size_t(count)), tables, out);
   }
 }
 
@@ -337,7 +351,7 @@ HWY_AFTER_NAMESPACE();
 namespace covrast::detail {
 
 HWY_EXPORT(LumaRow);
-HWY_EXPORT(FilterRow);
+HWY_EXPORT(FilterRows);
 
 FxaaKernels fxaa_kernels_simd() {
   // HWY_DYNAMIC_DISPATCH's first table entry is an initialising trampoline, so make the
@@ -345,7 +359,7 @@ FxaaKernels fxaa_kernels_simd() {
   hwy::ChosenTarget& chosen = hwy::GetChosenTarget();
   if (!chosen.IsInitialized()) chosen.Update(hwy::SupportedTargets());
   const std::size_t index = chosen.GetIndex();
-  return FxaaKernels{HWY_DISPATCH_TABLE(LumaRow)[index], HWY_DISPATCH_TABLE(FilterRow)[index]};
+  return FxaaKernels{HWY_DISPATCH_TABLE(LumaRow)[index], HWY_DISPATCH_TABLE(FilterRows)[index]};
 }
 
 }  // namespace covrast::detail

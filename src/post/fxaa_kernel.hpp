@@ -3,12 +3,12 @@
 //
 //   luma row:   L = float(299 r + 587 g + 114 b) / 255000, one IEEE division per pixel of
 //               the sRGB bytes (the integer sum is exact, and so is its conversion).
-//   filter row: for each pixel of row y, with the luma of its cross clamped to the frame,
+//   filter rows: for each pixel of row y, with the luma of its cross clamped to the frame,
 //                 max = max(max(max(m, n), max(s, w)), e), min likewise, range = max - min,
 //                 candidate <=> range > 0 and range >= max(edge_threshold_min,
 //                                                         max * edge_threshold);
 //               each candidate then goes through steps 2 to 5 of fxaa.hpp with exactly the
-//               IEEE operations, in the order, of the scalar twin's fxaa_pixel_blend and
+//               IEEE operations, in the order, of the scalar twin's fxaa_blend_scalar and
 //               blend_pixel (fxaa_kernel_scalar.cpp): 3x3 second differences, the sub-pixel
 //               weight, both searches along the edge (bilinear fetches at clamped pixels,
 //               one step per iteration, each direction stopping on its own), the nearer end's
@@ -22,7 +22,7 @@
 // Contract: the SIMD kernels (fxaa_kernel.cpp, one source for every Highway target) give the
 // scalar twin's (fxaa_kernel_scalar.cpp) luma bits and output bytes exactly, on every target;
 // tests/test_fxaa_kernel.cpp checks it per target. The filter writes only the pixels it
-// changes: `out` must hold a copy of the input row. Each output pixel depends only on the
+// changes: `out` must hold a copy of the input's rows. Each output pixel depends only on the
 // input frame and its luma, so any split of the rows over threads gives the same bytes.
 #pragma once
 
@@ -62,14 +62,15 @@ FxaaBlend fxaa_blend_scalar(const FxaaFrame& frame, const FxaaParams& params, in
 /// luma[i] = the luma of pixel i of `rgb` (3 bytes each), for i < width.
 using FxaaLumaRowFn = void (*)(const std::uint8_t* rgb, int width, float* luma);
 
-/// Row y of the filtered frame into `out` (3 * width bytes, holding the input row): the
-/// candidates FXAA blends with a weight other than 0 are rewritten, the others left alone.
-using FxaaFilterRowFn = void (*)(const FxaaFrame& frame, const FxaaParams& params, int y,
-                                 std::uint8_t* out);
+/// Rows [y_begin, y_end) of the filtered frame into `out` (the output frame, 3 * width *
+/// height bytes, holding the input's bytes in those rows): the candidates FXAA blends with
+/// a weight other than 0 are rewritten, the others left alone.
+using FxaaFilterRowsFn = void (*)(const FxaaFrame& frame, const FxaaParams& params, int y_begin,
+                                  int y_end, std::uint8_t* out);
 
 struct FxaaKernels {
   FxaaLumaRowFn luma_row;
-  FxaaFilterRowFn filter_row;
+  FxaaFilterRowsFn filter_rows;
 };
 
 /// The SIMD kernels of the target Highway dispatches to now (best supported, or forced with

@@ -146,19 +146,24 @@ void luma_row_scalar(const std::uint8_t* rgb, int width, float* luma) {
   }
 }
 
-void filter_row_scalar(const FxaaFrame& frame, const FxaaParams& params, int y, std::uint8_t* out) {
+void filter_rows_scalar(const FxaaFrame& frame, const FxaaParams& params, int y_begin, int y_end,
+                        std::uint8_t* out) {
   const int width = frame.width;
-  // Most pixels fail the contrast test, most of them with a flat cross: test them here on
-  // the luma rows (clamped at the frame's border), the others go through fxaa_blend_scalar.
-  const float* above = frame.luma + std::size_t(std::max(y - 1, 0)) * width;
-  const float* row = frame.luma + std::size_t(y) * width;
-  const float* below = frame.luma + std::size_t(std::min(y + 1, frame.height - 1)) * width;
-  for (int x = 0; x < width; ++x) {
-    const int left = std::max(x - 1, 0), right = std::min(x + 1, width - 1);
-    const float m = row[x];
-    if (m == above[x] && m == below[x] && m == row[left] && m == row[right]) continue;
-    if (passing_range(m, above[x], below[x], row[left], row[right], params) == 0.0f) continue;
-    blend_pixel(frame, x, y, fxaa_blend_scalar(frame, params, x, y), out + 3 * std::size_t(x));
+  for (int y = y_begin; y < y_end; ++y) {
+    // Most pixels fail the contrast test, most of them with a flat cross: test them here on
+    // the luma rows (clamped at the frame's border), the others go through fxaa_blend_scalar.
+    const float* above = frame.luma + std::size_t(std::max(y - 1, 0)) * width;
+    const float* row = frame.luma + std::size_t(y) * width;
+    const float* below = frame.luma + std::size_t(std::min(y + 1, frame.height - 1)) * width;
+    std::uint8_t* out_row = out + 3 * std::size_t(y) * width;
+    for (int x = 0; x < width; ++x) {
+      const int left = std::max(x - 1, 0), right = std::min(x + 1, width - 1);
+      const float m = row[x];
+      if (m == above[x] && m == below[x] && m == row[left] && m == row[right]) continue;
+      if (passing_range(m, above[x], below[x], row[left], row[right], params) == 0.0f) continue;
+      blend_pixel(frame, x, y, fxaa_blend_scalar(frame, params, x, y),
+                  out_row + 3 * std::size_t(x));
+    }
   }
 }
 
@@ -207,6 +212,6 @@ FxaaBlend fxaa_blend_scalar(const FxaaFrame& frame, const FxaaParams& params, in
   return {horizontal ? 0 : step, horizontal ? step : 0, weight};
 }
 
-FxaaKernels fxaa_kernels_scalar() { return {&luma_row_scalar, &filter_row_scalar}; }
+FxaaKernels fxaa_kernels_scalar() { return {&luma_row_scalar, &filter_rows_scalar}; }
 
 }  // namespace covrast::detail
