@@ -2,12 +2,12 @@
 // every Highway target; the best is picked at run time. Each lane does the scalar twin's IEEE
 // operations in its order (fxaa_kernel_scalar.cpp), so every target gives the same bits:
 //   - luma row: N pixels per vector (LoadInterleaved3 of the bytes, int32 sums, one division);
-//   - filter row: the contrast test on N pixels per vector (plain loads inside the row, clamped
-//     gathers at its ends), the passing pixels' x compressed into a list; then the list N
-//     candidates per vector: the 3x3 block, direction and sub-pixel weight, both searches
-//     along the edge (bilinear fetches by gather, a lane stopping when its own search ends,
-//     the vector when all have), the blend in linear light and the exact sRGB encode by
-//     gathers from encode_srgb8's tables.
+//   - filter rows: the contrast test on N pixels per vector (plain loads inside a row, clamped
+//     gathers at its ends), the passing pixels' (x, y) compressed into a list carried over the
+//     band's rows; then the list N candidates per vector: the 3x3 block, direction and
+//     sub-pixel weight, both searches along the edge (bilinear fetches by gather, a lane
+//     stopping when its own search ends, the vector when all have), the blend in linear light
+//     and the exact sRGB encode by gathers from encode_srgb8's tables.
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "post/fxaa_kernel.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
