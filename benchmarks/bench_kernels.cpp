@@ -14,6 +14,11 @@
 //                                          as the pipeline calls it (setup_chunk into
 //                                          ChunkSetups slices of one huge-page buffer plus
 //                                          pixel bounds, bin_chunk from those)
+//   stage/fxaa/<impl>                      the FXAA post-process of sphere_grid's aliased
+//                                          frame (1920x1080) on one thread: the luma rows,
+//                                          then the filter rows into a copy of the frame;
+//                                          <impl> scalar (the twins) or simd:<target>. The
+//                                          SIMD output is checked against the scalar first
 //
 // The coverage kernel runs on realistic inputs: random triangles inside a 64 x 64 tile, set
 // up group by group of kColumnGroup columns exactly as the coverage rasterizer does, and the
@@ -38,11 +43,13 @@
 #include "core/edge_function.hpp"
 #include "core/testing_hooks.hpp"
 #include "geometry/frontend.hpp"
+#include "post/fxaa.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
 #include "raster/samples/sample_kernel.hpp"
 #include "raster/samples/sample_pattern.hpp"
 #include "raster/samples/sample_raster.hpp"
 
+#include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
 #include <benchmark/benchmark.h>
@@ -754,6 +761,59 @@ void run_stage(benchmark::State& state, Body body) {
                          benchmark::Counter::kIsRate);
 }
 
+/// sphere_grid's aliased frame, rendered once for stage/fxaa.
+const covrast::Image& grid_aliased_frame() {
+  static const covrast::Image frame = [] {
+    covrast::RenderOptions options;
+    options.mode = covrast::parse_render_mode("aliased");
+    options.threads = 1;
+    return covrast::render(grid_stages().scene, options).color;
+  }();
+  return frame;
+}
+
+/// The whole post-process on one thread with `kernels`: luma, then filter into `output`.
+void fxaa_frame(const covrast::Image& input, const covrast::FxaaOptions& options,
+                const FxaaKernels& kernels, LumaPlane& luma, covrast::Image& output) {
+  output.rgb = input.rgb;
+  fxaa_luma_rows(input, luma, 0, input.height, kernels);
+  fxaa_rows(input, luma, options, output, 0, input.height, kernels);
+}
+
+void run_fxaa(benchmark::State& state, std::int64_t target) {
+  const covrast::Image* input = nullptr;
+  try {
+    input = &grid_aliased_frame();
+  } catch (const std::exception& e) {
+    state.SkipWithError(e.what());
+    return;
+  }
+  const covrast::FxaaOptions options;
+  LumaPlane luma{input->width, input->height,
+                 std::vector<float>(std::size_t(input->width) * input->height)};
+  covrast::Image output = *input, expected = *input;
+  fxaa_frame(*input, options, fxaa_kernels_scalar(), luma, expected);
+  if (target != 0) testing::force_simd_target(target);
+  const FxaaKernels kernels = target != 0 ? fxaa_kernels_simd() : fxaa_kernels_scalar();
+  if (target != 0) testing::force_simd_target(0);
+  fxaa_frame(*input, options, kernels, luma, output);
+  if (output.rgb != expected.rgb) {
+    state.SkipWithError("the SIMD output differs from the scalar twin's");
+    return;
+  }
+  for (auto _ : state) {
+    fxaa_frame(*input, options, kernels, luma, output);
+    benchmark::DoNotOptimize(output.rgb.data());
+  }
+  state.counters["pixels/s"] = benchmark::Counter(
+      double(state.iterations()) * double(input->rgb.size() / 3), benchmark::Counter::kIsRate);
+  std::size_t changed = 0;
+  for (std::size_t i = 0; i < output.rgb.size(); i += 3) {
+    changed += std::memcmp(&output.rgb[i], &input->rgb[i], 3) != 0;
+  }
+  state.counters["changed_pixels"] = double(changed);
+}
+
 void register_all() {
   struct Size {
     const char* name;
@@ -876,6 +936,13 @@ void register_all() {
                                })
       ->Unit(benchmark::kMillisecond)
       ->UseRealTime();
+  for (const auto& [impl, target] : impls) {
+    benchmark::RegisterBenchmark(
+        ("stage/fxaa/" + impl).c_str(),
+        [target = target](benchmark::State& state) { run_fxaa(state, target); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
 }
 
 }  // namespace

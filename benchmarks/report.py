@@ -763,8 +763,8 @@ def fxaa_comparison(results):
             f"Over {n} scenes, FXAA lowers aliased's RMSE on {better} (median ratio "
             f"{median(rmse_vs_aliased):.2f}, range {min(rmse_vs_aliased):.2f} to "
             f"{max(rmse_vs_aliased):.2f}); its RMSE is a median {median(rmse_vs_coverage):.0f}x "
-            f"coverage's. The post-process (`post_ms`, scalar, in parallel over rows) takes a "
-            f"median {fmt_ms(median(post_ms))} ms, and `fxaa` a median "
+            f"coverage's. The post-process (`post_ms`, SIMD kernels, in parallel over rows) "
+            f"takes a median {fmt_ms(median(post_ms))} ms, and `fxaa` a median "
             f"{median(time_ratio):.1f}x aliased's frame time.")
     sentences += [
         "What FXAA cannot fix ([fxaa.md](fxaa.md)): it sees one sample per pixel, so geometry "

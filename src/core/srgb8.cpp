@@ -25,11 +25,12 @@ std::array<float, 255> make_thresholds() {
 /// Buckets of the linear range: start[i] is the code of the smallest value of bucket i, so
 /// encoding is a table look-up plus at most a few threshold steps (the sRGB curve is
 /// steepest near 0, at 12.92 * 255 codes per unit: under one code per bucket).
-constexpr int kBuckets = 4096;
+constexpr int kBuckets = kSrgb8Buckets;
 
 struct Encoder {
   std::array<float, 256> threshold;  ///< threshold[255] = +inf as a sentinel
   std::array<std::uint8_t, kBuckets + 1> start;
+  std::array<std::int32_t, kBuckets + 1> start32;  ///< start, for 32-bit SIMD gathers
   Encoder() {
     auto t = make_thresholds();
     for (int k = 0; k < 255; ++k) threshold[k] = t[k];
@@ -39,6 +40,7 @@ struct Encoder {
       int code = 0;
       while (threshold[code] <= lo) ++code;
       start[i] = std::uint8_t(code);
+      start32[i] = code;
     }
   }
 };
@@ -61,6 +63,10 @@ inline std::uint8_t encode(float linear) {
 }  // namespace
 
 std::uint8_t encode_srgb8(float linear) { return encode(linear); }
+
+Srgb8EncodeTables srgb8_encode_tables() {
+  return {g_encoder.threshold.data(), g_encoder.start32.data()};
+}
 
 void write_tile(const FrameTarget& target, const PixelRect& rect, const glm::vec3* linear,
                 const float* depth, int stride) {

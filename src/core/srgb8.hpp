@@ -15,6 +15,16 @@ namespace covrast::detail {
 /// exact, and identical on every path.
 std::uint8_t encode_srgb8(float linear);
 
+/// encode_srgb8's tables, for SIMD encoders that must give its codes exactly: for x in (0, 1),
+/// code = start[int(x * kSrgb8Buckets)], then ++code while threshold[code] <= x; x <= 0 (or
+/// NaN) gives 0, x >= 1 gives 255.
+inline constexpr int kSrgb8Buckets = 4096;
+struct Srgb8EncodeTables {
+  const float* threshold;     ///< 256 values: the linear value of code k + 0.5; [255] = +inf
+  const std::int32_t* start;  ///< kSrgb8Buckets + 1 codes: the code of float(i) / kSrgb8Buckets
+};
+Srgb8EncodeTables srgb8_encode_tables();
+
 /// A window depth as the depth outputs store it, in [0, 1]: a plane evaluated at a pixel
 /// centre outside its triangle (a sliver's, steep) can leave the range; NaN becomes 1.
 inline float clamp_window_depth(float z) {

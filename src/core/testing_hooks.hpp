@@ -11,10 +11,10 @@
 namespace covrast::detail::testing {
 
 // SIMD targets. Every kernel (coverage rows and column set-up, sample masks, MSAA/SSAA sample
-// tests, the aliased depth test) is one source compiled for each target in HWY_TARGETS, with
-// the same flags, and dispatches through Highway's one chosen target: so one switch forces
-// them all, and the tests that compare each kernel with its scalar twin run once per target
-// (tests/test_targets.hpp).
+// tests, the aliased depth test, the FXAA rows) is one source compiled for each target in
+// HWY_TARGETS, with the same flags, and dispatches through Highway's one chosen target: so one
+// switch forces them all, and the tests that compare each kernel with its scalar twin run
+// once per target (tests/test_targets.hpp).
 
 /// The Highway targets compiled into this build (HWY_* bit flags; lower bits are better).
 std::int64_t compiled_simd_targets();

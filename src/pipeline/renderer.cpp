@@ -67,19 +67,26 @@ void check_fxaa_options(const FxaaOptions& fxaa) {
 /// FXAA over the finished frame: it reads a copy of the frame (the search along an edge
 /// reaches up to ~20 pixels away, across tiles), so each output pixel depends on the input
 /// only and any split over rows gives the same bytes. `input` and `luma` are per-frame
-/// memory kept by the Renderer. Call inside the arena.
+/// memory kept by the Renderer. Call inside the arena. The first pass copies the rows and
+/// computes their luma; the second rewrites, in the frame, only the pixels FXAA blends.
 void post_process_fxaa(const FxaaOptions& options, Image& input, detail::LumaPlane& luma,
                        Image& frame) {
-  input = frame;
+  input.width = frame.width;
+  input.height = frame.height;
+  input.rgb.resize(frame.rgb.size());
   luma.width = frame.width;
   luma.height = frame.height;
   luma.luma.resize(std::size_t(frame.width) * frame.height);
+  const detail::FxaaKernels kernels = detail::fxaa_kernels_simd();
   const auto rows = tbb::blocked_range<int>(0, frame.height, kPostRowsPerTask);
   detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
-    detail::fxaa_luma_rows(input, luma, r.begin(), r.end());
+    std::copy(frame.pixel(0, r.begin()),
+              frame.pixel(0, r.begin()) + 3 * std::size_t(frame.width) * r.size(),
+              input.pixel(0, r.begin()));
+    detail::fxaa_luma_rows(input, luma, r.begin(), r.end(), kernels);
   });
   detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
-    detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end());
+    detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end(), kernels);
   });
 }
 

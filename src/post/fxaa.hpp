@@ -13,7 +13,11 @@
 //      gives the weight 0.5 - distance / span length
 //   5. blend with the neighbour across the edge: out = (1 - w) in(M) + w in(neighbour),
 //      w = max(step 4, step 3), in linear light
+// The per-row work runs in the kernels of fxaa_kernel.hpp (SIMD, with a scalar twin that
+// gives the same bits); this file is the stage's interface.
 #pragma once
+
+#include "post/fxaa_kernel.hpp"
 
 #include <covrast/image.hpp>
 #include <covrast/options.hpp>
@@ -27,9 +31,8 @@ namespace covrast::detail {
 /// (FXAA_QUALITY__P0, P1, ...); empty for a preset FXAA 3.11 does not define.
 std::span<const float> fxaa_search_steps(int quality_preset);
 
-/// The luma FXAA works on: (299 r + 587 g + 114 b) / 255000 of the sRGB-encoded bytes, in
-/// [0, 1] (ITU-R BT.601 weights, as the FXAA 3.11 header computes it on non-linear colour).
-float fxaa_luma(const std::uint8_t* rgb);
+/// The kernels' view of `options` (a preset FXAA 3.11 defines).
+FxaaParams fxaa_params(const FxaaOptions& options);
 
 /// A frame's luma, row-major, width * height values.
 struct LumaPlane {
@@ -38,26 +41,27 @@ struct LumaPlane {
   std::vector<float> luma;
 };
 
-/// Writes rows [y_begin, y_end) of `plane` (already sized for `image`).
-void fxaa_luma_rows(const Image& image, LumaPlane& plane, int y_begin, int y_end);
+/// Writes rows [y_begin, y_end) of `plane` (already sized for `image`): the luma FXAA works
+/// on, (299 r + 587 g + 114 b) / 255000 of the sRGB-encoded bytes, in [0, 1] (ITU-R BT.601
+/// weights, as the FXAA 3.11 header computes it on non-linear colour).
+void fxaa_luma_rows(const Image& image, LumaPlane& plane, int y_begin, int y_end,
+                    const FxaaKernels& kernels = fxaa_kernels_simd());
 
-/// What FXAA does with one pixel: out = (1 - weight) in(x, y) + weight in(x + dx, y + dy),
-/// with (dx, dy) a 4-neighbour; weight 0 leaves the pixel as it is.
-struct FxaaBlend {
-  int dx = 0;
-  int dy = 0;
-  float weight = 0;  ///< in [0, max(0.5, subpix)]
-};
-
-/// Steps 1 to 4 for pixel (x, y). `steps` = fxaa_search_steps(options.quality_preset).
+/// Steps 1 to 4 for pixel (x, y), one pixel at a time (the scalar reference).
+/// `steps` = fxaa_search_steps(options.quality_preset).
 FxaaBlend fxaa_pixel_blend(const LumaPlane& plane, int x, int y, const FxaaOptions& options,
                            std::span<const float> steps);
 
-/// Writes rows [y_begin, y_end) of `output` (the size of `input`) from `input` and its luma.
+/// Filters rows [y_begin, y_end) of `output`, which holds the bytes of `input` in those rows
+/// (a copy of it): only the pixels FXAA changes are rewritten, from `input` and its luma.
 void fxaa_rows(const Image& input, const LumaPlane& plane, const FxaaOptions& options,
-               Image& output, int y_begin, int y_end);
+               Image& output, int y_begin, int y_end,
+               const FxaaKernels& kernels = fxaa_kernels_simd());
 
-/// The whole frame on the calling thread (tests, tools). Throws InputError on a bad preset.
-Image fxaa(const Image& input, const FxaaOptions& options);
+/// The whole frame on the calling thread (tests, tools), with the SIMD kernels or the scalar
+/// twins (the same bytes). Throws InputError on a bad preset or a side outside
+/// 1..kMaxImageSide.
+Image fxaa(const Image& input, const FxaaOptions& options,
+           const FxaaKernels& kernels = fxaa_kernels_simd());
 
 }  // namespace covrast::detail
