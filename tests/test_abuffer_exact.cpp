@@ -12,6 +12,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include "test_meshes.hpp"
 
 #include <algorithm>
@@ -185,11 +187,9 @@ struct BothResolves {
 BothResolves both_resolves(const Scene& s, bool cull = true) {
   BothResolves r{render(s, ModeKind::Coverage, cull), {}};
   covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
-  hooks.mask_resolve = true;
-  hooks.pixel_path_only = true;
+  const covrast::test::ScopedHook masks_only(hooks.mask_resolve, true);
+  const covrast::test::ScopedHook pixels_only(hooks.pixel_path_only, true);
   r.masks = render(s, ModeKind::Coverage, cull);
-  hooks.mask_resolve = false;
-  hooks.pixel_path_only = false;
   return r;
 }
 

@@ -16,6 +16,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include "test_targets.hpp"
 
 #include <algorithm>
@@ -571,7 +573,7 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
     CHECK(m.rows == 0);
   }
   for (std::int64_t target : targets) {
-    covrast::detail::testing::force_simd_target(target);
+    const covrast::test::ScopedSimdTarget forced(target);
     INFO("target " << hwy::TargetName(target));
     CHECK(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     const Mismatch m = compare({Path::KernelAllRows, Path::KernelLikeDraw, Path::Fused});
@@ -580,7 +582,6 @@ TEST_CASE("coverage kernel: every SIMD target gives the scalar twin's bits", "[c
     CHECK(m.beyond == 0);
     CHECK(m.rows == 0);
   }
-  covrast::detail::testing::force_simd_target(0);
   CHECK(hwy::SupportedTargets() == supported);
 }
 
@@ -638,7 +639,7 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
     covrast::detail::coverage_rows_scalar(*cols, col, row_begin, row_begin + kRows, sign,
                                           scalar.data(), kColumnGroup);
     for (std::int64_t target : targets) {
-      covrast::detail::testing::force_simd_target(target);
+      const covrast::test::ScopedSimdTarget forced(target);
       std::fill(simd.begin(), simd.end(), kPoison);
       covrast::detail::coverage_rows_simd(*cols, col, row_begin, row_begin + kRows, sign,
                                           simd.data(), kColumnGroup);
@@ -662,7 +663,6 @@ TEST_CASE("coverage kernel: SIMD equals scalar on raw column inputs", "[coverage
       }
     }
   }
-  covrast::detail::testing::force_simd_target(0);
   INFO(first);
   CHECK(compared == 3000u * targets.size() * kRows * kColumnGroup);
   CHECK(differing == 0);

@@ -18,6 +18,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include "raster/coverage/abuffer.hpp"
 #include "test_meshes.hpp"
 #include "test_targets.hpp"
@@ -365,13 +367,9 @@ namespace {
 
 /// A-buffers made while it lives keep at most `fragments` per pixel, so that small scenes
 /// reach the overflow policy (the product's limit, kMaxFragmentsPerPixel, is larger).
-struct FragmentCapacity {
-  explicit FragmentCapacity(int fragments) {
-    covrast::detail::testing::coverage_hooks.fragment_capacity = fragments;
-  }
-  ~FragmentCapacity() { covrast::detail::testing::coverage_hooks.fragment_capacity = 0; }
-  FragmentCapacity(const FragmentCapacity&) = delete;
-  FragmentCapacity& operator=(const FragmentCapacity&) = delete;
+struct FragmentCapacity : covrast::test::ScopedHook<int> {
+  explicit FragmentCapacity(int fragments)
+      : ScopedHook(covrast::detail::testing::coverage_hooks.fragment_capacity, fragments) {}
 };
 constexpr int kTestCapacity = 32;
 
@@ -1050,7 +1048,7 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
   std::string names;
   for (std::int64_t target : targets) {
     names += std::string(hwy::TargetName(target)) + " ";
-    covrast::detail::testing::force_simd_target(target);
+    const covrast::test::ScopedSimdTarget forced(target);
     for (int threads : {1, 2}) {
       for (int tile : {8, 16, 64, 256}) {
         INFO("target " << hwy::TargetName(target) << ", threads " << threads << ", tile " << tile);
@@ -1061,7 +1059,6 @@ TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD t
       }
     }
   }
-  covrast::detail::testing::force_simd_target(0);
   WARN("determinism (coverage and aliased) checked on targets: "
        << names << "x threads {1, 2} x tiles {8, 16, 64, 256}");
   CHECK(targets.size() >= 1);
@@ -1085,9 +1082,10 @@ TEST_CASE("coverage modes: the scalar twin of the kernel renders the SIMD kernel
         o.tile = tile;
         o.threads = 2;
         o.want_depth = true;
-        hooks.scalar_kernel = true;
-        const auto scalar = covrast::render(s, o);
-        hooks.scalar_kernel = false;
+        const auto scalar = [&] {
+          const covrast::test::ScopedHook scalar_kernel(hooks.scalar_kernel, true);
+          return covrast::render(s, o);
+        }();
         covrast::test::for_each_target([&](std::int64_t) {
           const auto simd = covrast::render(s, o);
           REQUIRE(simd.color.rgb.size() == scalar.color.rgb.size());
@@ -1139,9 +1137,11 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
       o.threads = 2;
       o.want_depth = true;
       const auto fast = covrast::render(s, o);
-      covrast::detail::testing::coverage_hooks.pixel_path_only = true;
-      const auto slow = covrast::render(s, o);
-      covrast::detail::testing::coverage_hooks.pixel_path_only = false;
+      const auto slow = [&] {
+        const covrast::test::ScopedHook pixels_only(
+            covrast::detail::testing::coverage_hooks.pixel_path_only, true);
+        return covrast::render(s, o);
+      }();
       fast_blocks += fast.stats.resolve_paths.uniform_tile + fast.stats.resolve_paths.uniform_block;
       slow_blocks += slow.stats.resolve_paths.uniform_tile + slow.stats.resolve_paths.uniform_block;
       REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
@@ -1174,10 +1174,11 @@ TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from th
     INFO("tile " << tile);
     const auto sums = render(s, ModeKind::Coverage, 2, tile);
     const Image& with_sums = sums.color;
-    hooks.list_resolve = true;
-    const auto lists = render(s, ModeKind::Coverage, 2, tile);
+    const auto lists = [&] {
+      const covrast::test::ScopedHook lists_only(hooks.list_resolve, true);
+      return render(s, ModeKind::Coverage, 2, tile);
+    }();
     const Image& lists_only = lists.color;
-    hooks.list_resolve = false;
     CHECK(sums.stats.resolve_paths.layer_sums > 1000);  // the sums resolved many pixels...
     CHECK(lists.stats.resolve_paths.layer_sums == 0);   // ...and none when forced off
     // ...which the list resolve then adds up as disjoint fragments.

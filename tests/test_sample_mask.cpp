@@ -12,6 +12,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include "test_targets.hpp"
 
 #include <algorithm>
@@ -124,11 +126,10 @@ void for_each_implementation(const std::function<void(const std::string&, MaskFn
   REQUIRE(!targets.empty());
   check("scalar", pixel_sample_mask_scalar);
   for (std::int64_t target : targets) {
-    force_simd_target(target);
+    const covrast::test::ScopedSimdTarget forced(target);
     REQUIRE(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     check(hwy::TargetName(target), pixel_sample_mask);
   }
-  force_simd_target(0);
 }
 
 TEST_CASE("sample mask: the lattice has one sample in every fine column and row", "[coverage]") {

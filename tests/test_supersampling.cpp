@@ -21,6 +21,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include "test_targets.hpp"
 
 #include <algorithm>
@@ -901,10 +903,11 @@ TEST_CASE(
     if (reference) continue;  // no SIMD kernels in the reference mode
     for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
-      covrast::detail::testing::force_simd_target(target);
       INFO("target " << hwy::TargetName(target));
-      const Image img = render_mode(s, mode, 2, 64).color;
-      covrast::detail::testing::force_simd_target(0);
+      const Image img = [&] {
+        const covrast::test::ScopedSimdTarget forced(target);
+        return render_mode(s, mode, 2, 64).color;
+      }();
       REQUIRE(img.rgb == base.rgb);
       ++forced;
     }
@@ -918,10 +921,9 @@ TEST_CASE(
   // Forcing really switches the kernels: one distinct function per target.
   std::vector<covrast::detail::SampleGroupFn> kernels;
   for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
-    covrast::detail::testing::force_simd_target(bits & -bits);
+    const covrast::test::ScopedSimdTarget forced(bits & -bits);
     kernels.push_back(covrast::detail::sample_kernels_simd().sample);
   }
-  covrast::detail::testing::force_simd_target(0);
   std::sort(kernels.begin(), kernels.end(), std::less<covrast::detail::SampleGroupFn>());
   REQUIRE(std::unique(kernels.begin(), kernels.end()) - kernels.begin() ==
           std::ptrdiff_t(kernels.size()));

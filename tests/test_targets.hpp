@@ -8,6 +8,8 @@
 
 #include <catch2/catch.hpp>
 
+#include "test_hooks.hpp"
+
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -30,12 +32,11 @@ template <class Check>
 void for_each_target(Check check) {
   const std::int64_t supported = hwy::SupportedTargets();
   for (const std::int64_t target : usable_targets()) {
-    covrast::detail::testing::force_simd_target(target);
+    const ScopedSimdTarget forced(target);
     INFO("SIMD target " << hwy::TargetName(target));
     REQUIRE(std::string(covrast::detail::testing::simd_target_name()) == hwy::TargetName(target));
     check(target);
   }
-  covrast::detail::testing::force_simd_target(0);
   CHECK(hwy::SupportedTargets() == supported);
 }
 

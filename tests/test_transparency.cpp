@@ -7,7 +7,9 @@
 #include <covrast/scene.hpp>
 
 #include <catch2/catch.hpp>
+
 #include <nlohmann/json.hpp>
+#include "test_hooks.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -456,9 +458,11 @@ TEST_CASE("The uniform-layer shortcut gives what the per-sample composite gives"
   // take the 256-sample composite of the general formula.
   const covrast::Scene scene = blend_quads({2, 0, 1});
   const covrast::Image fast = render(scene, "coverage");
-  covrast::detail::testing::coverage_hooks.mask_resolve = true;
-  const covrast::Image samples = render(scene, "coverage");
-  covrast::detail::testing::coverage_hooks.mask_resolve = false;
+  const covrast::Image samples = [&] {
+    const covrast::test::ScopedHook masks_only(
+        covrast::detail::testing::coverage_hooks.mask_resolve, true);
+    return render(scene, "coverage");
+  }();
   REQUIRE(max_difference(fast, samples) <= 1);
 }
 
