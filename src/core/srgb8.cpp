@@ -1,5 +1,6 @@
 // Resolve stage: sRGB encoding and tile copy-out; see srgb8.hpp.
 #include "core/srgb8.hpp"
+#include "core/srgb.hpp"
 
 #include <covrast/scene.hpp>
 
@@ -16,7 +17,7 @@ std::array<float, 255> make_thresholds() {
   std::array<float, 255> t{};
   for (int k = 0; k < 255; ++k) {
     double e = (k + 0.5) / 255.0;
-    double lin = e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4);
+    double lin = srgb_decode(e);
     t[k] = float(lin);
   }
   return t;

@@ -2,6 +2,7 @@
 // scene load (make_texture) and sampling it (texture_sampling.hpp), each texel decoded to
 // linear light by a 256-entry table. Double precision throughout, no contraction: the same
 // bits in every mode, tile, thread and compiler.
+#include "core/srgb.hpp"
 #include "core/texture_sampling.hpp"
 
 #include <covrast/error.hpp>
@@ -14,11 +15,8 @@
 namespace covrast {
 namespace {
 
-/// IEC 61966-2-1 decoding of an encoded value c in [0, 1]:
-/// c <= 0.04045 ? c / 12.92 : ((c + 0.055) / 1.055)^2.4.
-double srgb_to_linear(double c) {
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
+/// IEC 61966-2-1 decoding of an encoded value c in [0, 1] (core/srgb.hpp).
+double srgb_to_linear(double c) { return detail::srgb_decode(c); }
 
 /// One encoding of a stored channel: code / 255 (linear slots, and alpha always) or sRGB (the
 /// RGB of sRGB slots). `linear` holds the 256 codes in linear light (sampling); `threshold`

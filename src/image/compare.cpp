@@ -4,6 +4,7 @@
 // reproducible.
 #include <covrast/compare.hpp>
 #include <covrast/error.hpp>
+#include "core/srgb.hpp"
 
 #include <nlohmann/json.hpp>
 
@@ -24,15 +25,13 @@ constexpr int kHeatmapSaturationSrgb8 = 32;
 // The ramp black -> blue -> green -> yellow -> red has four equal segments.
 constexpr int kHeatmapSegmentSrgb8 = kHeatmapSaturationSrgb8 / 4;
 
-// IEC 61966-2-1 sRGB decoding, c = code / 255:
-//   linear = c / 12.92                        for c <= 0.04045
-//   linear = ((c + 0.055) / 1.055) ^ 2.4      otherwise
-// computed once in double for all 256 codes.
+// IEC 61966-2-1 sRGB decoding (core/srgb.hpp) of c = code / 255, computed once in double for
+// all 256 codes.
 std::array<double, 256> make_srgb8_to_linear_table() {
   std::array<double, 256> table{};
   for (int code = 0; code < 256; ++code) {
     const double c = code / 255.0;
-    table[std::size_t(code)] = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+    table[std::size_t(code)] = detail::srgb_decode(c);
   }
   return table;
 }

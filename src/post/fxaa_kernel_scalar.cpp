@@ -1,5 +1,6 @@
 // Post-process stage, FXAA: the scalar twins of the row kernels (fxaa_kernel.hpp), one pixel
 // at a time. Written from the published description of FXAA 3.11 (fxaa.hpp, docs/fxaa.md).
+#include "core/srgb.hpp"
 #include "post/fxaa_kernel.hpp"
 
 #include "core/srgb8.hpp"
@@ -114,7 +115,7 @@ std::array<float, 256> make_srgb8_linear() {
   std::array<float, 256> t{};
   for (int k = 0; k < 256; ++k) {
     const double e = k / 255.0;
-    t[k] = float(e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4));
+    t[k] = float(srgb_decode(e));
   }
   return t;
 }

@@ -1,6 +1,7 @@
 // Colour helpers of the scene format: the sRGB transfer function (IEC 61966-2-1) used to turn
 // the sRGB display values of scene files into linear light, and the per_triangle debug colour.
 #include <covrast/scene.hpp>
+#include "core/srgb.hpp"
 
 #include <array>
 #include <cmath>
@@ -12,8 +13,7 @@ float srgb_to_linear(float encoded) {
   if (!(encoded > 0.0f)) return 0.0f;
   if (encoded >= 1.0f) return 1.0f;
   const double c = encoded;
-  // c <= 0.04045: c / 12.92, else ((c + 0.055) / 1.055)^2.4
-  const double linear = c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+  const double linear = detail::srgb_decode(c);
   return static_cast<float>(linear);
 }
 
@@ -21,8 +21,7 @@ float linear_to_srgb(float linear) {
   if (!(linear > 0.0f)) return 0.0f;
   if (linear >= 1.0f) return 1.0f;
   const double c = linear;
-  // c <= 0.0031308: 12.92 c, else 1.055 c^(1/2.4) - 0.055
-  const double encoded = c <= 0.0031308 ? 12.92 * c : 1.055 * std::pow(c, 1.0 / 2.4) - 0.055;
+  const double encoded = detail::srgb_encode(c);
   return static_cast<float>(encoded);
 }
 

@@ -9,6 +9,7 @@
 //   end_tile shades each pixel once, for that triangle, at the same point (x + 0.5, y + 0.5):
 //   the colour the winning triangle would have written when it won.
 #include "core/shading.hpp"
+#include "core/srgb.hpp"
 #include "core/srgb8.hpp"
 #include "core/tile_raster.hpp"
 #include "raster/aliased/aliased_kernel.hpp"
@@ -37,10 +38,7 @@ std::uint64_t flat_owner(const std::uint8_t code[3]) {
 
 /// The linear value of an 8-bit sRGB code (IEC 61966-2-1): encode_srgb8 of it gives the code
 /// back, so a pixel that no BLEND triangle covers keeps its bytes.
-double decode_srgb8(std::uint8_t code) {
-  const double c = code / 255.0;
-  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
-}
+double decode_srgb8(std::uint8_t code) { return srgb_decode(code / 255.0); }
 
 void write_codes(std::uint64_t owner, std::uint8_t* dst) {
   dst[0] = std::uint8_t(owner >> 8);
