@@ -337,6 +337,7 @@ bool ABufferTile::pairwise_disjoint(std::size_t pixel, std::uint32_t only) const
       const int nb = fragment_pieces(g, b);
       for (int i = 0; i < na; ++i) {
         for (int k = 0; k < nb; ++k) {
+          if (one_convex_facing(*a[i], *b[k])) continue;  // taken as disjoint (see abuffer.hpp)
           if (!interiors_disjoint(*a[i], *b[k])) return false;
         }
       }
