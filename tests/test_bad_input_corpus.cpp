@@ -541,7 +541,7 @@ std::vector<Case> gltf_cases() {
     const int weights = builder.add_floats({1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}, "VEC4");
     builder.gltf["scenes"][0]["nodes"] = {0, 1};
     builder.gltf["nodes"] = {{{"mesh", 0}, {"skin", 0}}, json::object()};
-    builder.gltf["skins"] = {{{"joints", {1}}}};
+    builder.gltf["skins"] = json::array({{{"joints", {1}}}});
     builder.gltf["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = joints;
     builder.gltf["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = weights;
     return builder.gltf_text();
@@ -552,12 +552,13 @@ std::vector<Case> gltf_cases() {
     const int uv = builder.add_floats({0, 0, 1, 0, 0, 1}, "VEC2");
     builder.gltf["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
     builder.gltf["meshes"][0]["primitives"][0]["material"] = 0;
-    builder.gltf["materials"] = {
-        {{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
-    builder.gltf["textures"] = {{{"source", 0}, {"sampler", 0}}};
-    builder.gltf["samplers"] = {json::object()};
+    builder.gltf["materials"] =
+        json::array({{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}});
+    builder.gltf["textures"] = json::array({{{"source", 0}, {"sampler", 0}}});
+    builder.gltf["samplers"] = json::array({json::object()});
     const std::string png = good_png(2, 2);
-    builder.gltf["images"] = {{{"uri", "data:image/png;base64," + covrast::test::base64(png)}}};
+    builder.gltf["images"] =
+        json::array({{{"uri", "data:image/png;base64," + covrast::test::base64(png)}}});
     edit(builder.gltf);
     return builder.gltf_text();
   };
@@ -578,9 +579,11 @@ std::vector<Case> gltf_cases() {
   }();
   const auto with_light = [](const std::string& type) {
     GltfBuilder builder = triangle_gltf();
-    builder.gltf["extensionsUsed"] = {"KHR_lights_punctual"};
+    builder.gltf["extensionsUsed"] = json::array({"KHR_lights_punctual"});
+    // json::array: a braced list of one element is an array for g++ but a copy of the
+    // element for clang (nlohmann::json's initializer-list constructor).
     builder.gltf["extensions"] = {
-        {"KHR_lights_punctual", {{"lights", {{{"type", type}, {"range", 0}}}}}}};
+        {"KHR_lights_punctual", {{"lights", json::array({{{"type", type}, {"range", 0}}})}}}};
     builder.gltf["nodes"][0]["extensions"] = {{"KHR_lights_punctual", {{"light", 0}}}};
     return builder.gltf_text();
   };
