@@ -2,6 +2,7 @@
 #pragma once
 
 #include <cstdint>
+#include <utility>
 
 namespace covrast {
 
@@ -21,24 +22,38 @@ struct CoverageResolvePaths {
   std::uint64_t overflowed = 0;     ///< the list overflowed into 256 depth-tested samples
   std::uint64_t transparent = 0;    ///< BLEND fragments composited in depth order
 
-  std::uint64_t total() const {
-    return uniform_tile + uniform_block + opaque + layer_sums + disjoint + front_layer + clipped +
-           samples + overflowed + transparent;
-  }
-  CoverageResolvePaths& operator+=(const CoverageResolvePaths& o) {
-    uniform_tile += o.uniform_tile;
-    uniform_block += o.uniform_block;
-    opaque += o.opaque;
-    layer_sums += o.layer_sums;
-    disjoint += o.disjoint;
-    front_layer += o.front_layer;
-    clipped += o.clipped;
-    samples += o.samples;
-    overflowed += o.overflowed;
-    transparent += o.transparent;
-    return *this;
-  }
+  std::uint64_t total() const;
+  CoverageResolvePaths& operator+=(const CoverageResolvePaths& o);
 };
+
+/// Every field of CoverageResolvePaths with its name (as `covrast render --stats` prints it):
+/// the one list that sums, totals and prints go through.
+inline constexpr std::pair<const char*, std::uint64_t CoverageResolvePaths::*>
+    kCoverageResolvePathFields[] = {{"uniform_tile", &CoverageResolvePaths::uniform_tile},
+                                    {"uniform_block", &CoverageResolvePaths::uniform_block},
+                                    {"opaque", &CoverageResolvePaths::opaque},
+                                    {"layer_sums", &CoverageResolvePaths::layer_sums},
+                                    {"disjoint", &CoverageResolvePaths::disjoint},
+                                    {"front_layer", &CoverageResolvePaths::front_layer},
+                                    {"clipped", &CoverageResolvePaths::clipped},
+                                    {"samples", &CoverageResolvePaths::samples},
+                                    {"overflowed", &CoverageResolvePaths::overflowed},
+                                    {"transparent", &CoverageResolvePaths::transparent}};
+static_assert(sizeof(CoverageResolvePaths) == sizeof(kCoverageResolvePathFields) /
+                                                  sizeof(kCoverageResolvePathFields[0]) *
+                                                  sizeof(std::uint64_t),
+              "kCoverageResolvePathFields lists every field");
+
+inline std::uint64_t CoverageResolvePaths::total() const {
+  std::uint64_t sum = 0;
+  for (const auto& field : kCoverageResolvePathFields) sum += this->*field.second;
+  return sum;
+}
+
+inline CoverageResolvePaths& CoverageResolvePaths::operator+=(const CoverageResolvePaths& o) {
+  for (const auto& field : kCoverageResolvePathFields) this->*field.second += o.*field.second;
+  return *this;
+}
 
 /// Counts and stage times of one frame. Times are wall-clock milliseconds on the calling
 /// process; counts are exact.

@@ -63,17 +63,8 @@ nlohmann::ordered_json stats_json(const RenderOptions& options, const RenderResu
                     {"bin_entries", s.bin_entries}};
   j["fragment_overflows"] = s.fragment_overflows;
   // Pixels per A-buffer resolve path (coverage mode; docs/coverage.md), of the last frame.
-  const CoverageResolvePaths& p = s.resolve_paths;
-  j["resolve_paths"] = {{"uniform_tile", p.uniform_tile},
-                        {"uniform_block", p.uniform_block},
-                        {"opaque", p.opaque},
-                        {"layer_sums", p.layer_sums},
-                        {"disjoint", p.disjoint},
-                        {"front_layer", p.front_layer},
-                        {"clipped", p.clipped},
-                        {"samples", p.samples},
-                        {"overflowed", p.overflowed},
-                        {"transparent", p.transparent}};
+  nlohmann::ordered_json& paths = j["resolve_paths"] = nlohmann::ordered_json::object();
+  for (const auto& [name, field] : kCoverageResolvePathFields) paths[name] = s.resolve_paths.*field;
   j["scratch_bytes"] = s.scratch_bytes;
   j["setup_ms"] = median_of(&RenderStats::setup_ms);
   j["binning_ms"] = median_of(&RenderStats::binning_ms);

@@ -7,12 +7,10 @@
 #pragma once
 
 #if !defined(NDEBUG) || defined(COVRAST_CHECKS)
-#define COVRAST_CHECKS_ON 1
 #define COVRAST_CHECK(condition, what) \
   ((condition) ? static_cast<void>(0)  \
                : ::covrast::detail::check_failed(#condition, what, __FILE__, __LINE__))
 #else
-#define COVRAST_CHECKS_ON 0
 #define COVRAST_CHECK(condition, what) static_cast<void>(0)
 #endif
 

@@ -15,9 +15,6 @@
 namespace covrast {
 namespace {
 
-/// IEC 61966-2-1 decoding of an encoded value c in [0, 1] (core/srgb.hpp).
-double srgb_to_linear(double c) { return detail::srgb_decode(c); }
-
 /// One encoding of a stored channel: code / 255 (linear slots, and alpha always) or sRGB (the
 /// RGB of sRGB slots). `linear` holds the 256 codes in linear light (sampling); `threshold`
 /// the 255 linear values where the nearest code changes, threshold[k] = decode((k + 0.5) /
@@ -53,7 +50,7 @@ struct ChannelCode {
 /// Built once at start-up (no guard on every texel fetch, as a function-local static would
 /// need); nothing builds or samples a texture during static initialisation.
 const ChannelCode g_unit([](double c) { return c; });
-const ChannelCode g_srgb(srgb_to_linear);
+const ChannelCode g_srgb(detail::srgb_decode);
 
 /// Decodes stored texels: RGB through the texture's encoding, alpha as code / 255.
 struct TexelDecoder {

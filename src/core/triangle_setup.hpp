@@ -71,6 +71,10 @@ struct PixelRect {
   int x1 = 0;
   int y1 = 0;
   bool empty() const { return x0 >= x1 || y0 >= y1; }
+  /// Pixels in the rectangle (0 when empty).
+  std::uint64_t pixel_count() const {
+    return empty() ? 0 : std::uint64_t(x1 - x0) * std::uint64_t(y1 - y0);
+  }
 };
 
 /// Pixels that a triangle with these vertices [fx8, any order] can touch: floor of the

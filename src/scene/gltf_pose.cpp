@@ -135,7 +135,7 @@ std::vector<glm::dmat4> vertex_skin_matrices(const std::vector<SkinInfluences>& 
         fail(name, what + ": joint " + number_text(joint) + " out of range (" +
                        std::to_string(joints.size()) + " joints)");
       }
-      skin[i / 4] += set.weights[i] * joints[static_cast<std::size_t>(set.joints[i])];
+      skin[i / 4] += set.weights[i] * joints[static_cast<std::size_t>(joint)];
     }
   }
   return skin;

@@ -142,7 +142,7 @@ class MtlParser {
                                       [&](const auto& o) { return o.first == option; });
       if (known == kOptions.end()) break;  // the file name (which may start with '-')
       tokens = ahead;
-      const bool vector = known->first == "-o" || known->first == "-s" || known->first == "-t";
+      const bool vector = known->second == 3;  // -o, -s, -t
       for (int k = 0; k < known->second; ++k) {
         Tokens value_ahead = tokens;
         std::string_view value;

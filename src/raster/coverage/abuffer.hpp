@@ -92,6 +92,17 @@ inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
   return (same[0] | same[1] | same[2]) != 0;
 }
 
+/// Whether a and b are pieces of one convex surface with one facing, which the open set
+/// takes as disjoint without a test. Exact for the true projection; after snapping to the
+/// 1/256 grid, a sliver at the silhouette whose snapped facing differs from its true one can
+/// overlap its neighbours by part of its own (tiny) area: on the sphere grid at 96x54 the
+/// exact test everywhere changes 23 pixels by at most 4/255, at 1920x1080 none by more than
+/// 1/255.
+inline bool one_convex_facing(const TriangleSetup& a, const TriangleSetup& b) {
+  return a.convex_surface && b.convex_surface && a.surface == b.surface &&
+         a.front_facing == b.front_facing;
+}
+
 class ABufferTile {
  public:
   explicit ABufferTile(int tile_px);
@@ -322,16 +333,6 @@ class ABufferTile {
   static constexpr std::uint32_t kNoConvexKey = 0xffffffffu;
   static std::uint32_t convex_key(const TriangleSetup& t) {
     return t.convex_surface ? t.surface * 2 + (t.front_facing ? 1u : 0u) : kNoConvexKey;
-  }
-  /// Whether a and b are pieces of one convex surface with one facing, which the open set
-  /// takes as disjoint without a test. Exact for the true projection; after snapping to the
-  /// 1/256 grid, a sliver at the silhouette whose snapped facing differs from its true one
-  /// can overlap its neighbours by part of its own (tiny) area: on the sphere grid at 96x54
-  /// the exact test everywhere changes 23 pixels by at most 4/255, at 1920x1080 none by
-  /// more than 1/255.
-  static bool one_convex_facing(const TriangleSetup& a, const TriangleSetup& b) {
-    return a.convex_surface && b.convex_surface && a.surface == b.surface &&
-           a.front_facing == b.front_facing;
   }
   /// Colour of a layer in front of everything else (abuffer_resolve.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);

@@ -87,9 +87,12 @@ struct FragmentPieces {
 };
 
 /// Whether two fragments' triangles have pairwise disjoint interiors (triangle_overlap.hpp).
-bool fragments_disjoint(FragmentPieces a, FragmentPieces b) {
+/// With `as_open_set`, pairs of one convex surface and facing count as disjoint untested, as
+/// the open set takes them (one_convex_facing).
+bool fragments_disjoint(FragmentPieces a, FragmentPieces b, bool as_open_set = false) {
   for (int i = 0; i < a.count; ++i) {
     for (int j = 0; j < b.count; ++j) {
+      if (as_open_set && one_convex_facing(*a.piece[i], *b.piece[j])) continue;
       if (!interiors_disjoint(*a.piece[i], *b.piece[j])) return false;
     }
   }
@@ -329,18 +332,13 @@ bool ABufferTile::pairwise_disjoint(std::size_t pixel, std::uint32_t only) const
   auto member = [&](std::uint32_t f) { return only == 0 || (pool_[f].coverage & only) != 0; };
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     if (!member(f)) continue;
-    const TriangleSetup* const* a;
-    const int na = fragment_pieces(f, a);
+    FragmentPieces a{};
+    a.count = fragment_pieces(f, a.piece);
     for (std::uint32_t g = pool_[f].next; g != kEnd; g = pool_[g].next) {
       if (!member(g)) continue;
-      const TriangleSetup* const* b;
-      const int nb = fragment_pieces(g, b);
-      for (int i = 0; i < na; ++i) {
-        for (int k = 0; k < nb; ++k) {
-          if (one_convex_facing(*a[i], *b[k])) continue;  // taken as disjoint (see abuffer.hpp)
-          if (!interiors_disjoint(*a[i], *b[k])) return false;
-        }
-      }
+      FragmentPieces b{};
+      b.count = fragment_pieces(g, b.piece);
+      if (!fragments_disjoint(a, b, true)) return false;
     }
   }
   return true;
@@ -349,14 +347,13 @@ bool ABufferTile::pairwise_disjoint(std::size_t pixel, std::uint32_t only) const
 void ABufferTile::resolve(const FrameTarget& target) {
   [[maybe_unused]] const std::uint64_t counted_before = paths_.total();
   resolve_tile(target);
-  COVRAST_CHECK(paths_.total() - counted_before ==
-                    std::uint64_t(rect_.x1 - rect_.x0) * std::uint64_t(rect_.y1 - rect_.y0),
+  COVRAST_CHECK(paths_.total() - counted_before == rect_.pixel_count(),
                 "every pixel of a tile takes exactly one resolve path");
 }
 
 void ABufferTile::resolve_tile(const FrameTarget& target) {
   if (tile_uniform_) {
-    paths_.uniform_tile += std::uint64_t(rect_.x1 - rect_.x0) * std::uint64_t(rect_.y1 - rect_.y0);
+    paths_.uniform_tile += rect_.pixel_count();
     resolve_opaque_block(uniform_, rect_, target);
     return;
   }
@@ -370,7 +367,7 @@ void ABufferTile::resolve_tile(const FrameTarget& target) {
       const std::size_t block = std::size_t(by) * block_stride_ + bx;
       const PixelRect br = block_rect(block);
       if (block_uniform_[block]) {
-        paths_.uniform_block += std::uint64_t(br.x1 - br.x0) * std::uint64_t(br.y1 - br.y0);
+        paths_.uniform_block += br.pixel_count();
         resolve_opaque_block(block_opaque_[block], br, target);
         continue;
       }
