@@ -41,6 +41,10 @@ struct CrossingEdges {
   std::int32_t dx[3];
   std::int32_t dy[3];
   int count;  ///< 1 to 3
+  /// Samples [k_begin, k_end) can be inside: those within the triangle's x extent (the
+  /// rest are 0 without a test, see pixel_sample_mask).
+  int k_begin;
+  int k_end;
 };
 
 }  // namespace covrast::detail
@@ -78,7 +82,9 @@ HWY_INLINE SampleMask CrossingMask(const CrossingEdges& c) {
     dy[e] = hn::Set(d, c.dy[e]);
   }
   SampleMask mask = SampleMask::none();
-  for (int k0 = 0; k0 < kMaskSamples; k0 += n) {
+  // From the vector holding k_begin: lanes outside the range are tested like the others
+  // (and are outside), so the bits are those of the whole loop.
+  for (int k0 = c.k_begin - c.k_begin % n; k0 < c.k_end; k0 += n) {
     const auto sx = hn::LoadU(d, kMaskSampleX_fx9.data() + k0);
     const auto sy = hn::LoadU(d, kMaskSampleY_fx9.data() + k0);
     auto any = hn::Sub(hn::Add(base[0], hn::Mul(dx[0], sy)), hn::Mul(dy[0], sx));
@@ -143,6 +149,16 @@ SampleMask pixel_sample_mask(const TriangleSetup& t, int x, int y) {
   }
   if (crossing.count == 0) return SampleMask::all();
   if (!narrow) return pixel_sample_mask_scalar(t, x, y);
+  // Sample k lies at x offset 2k + 1 [fx9], odd, and the vertices on even ones (the 24.8
+  // grid): a sample left of the triangle's leftmost vertex (2k + 1 < 2 min_x, k < min_x)
+  // or right of its rightmost (k >= max_x), x relative to the pixel [fx8], is strictly
+  // outside an edge, so no bias can take it in. Tiny triangles of dense meshes cover a
+  // fraction of the pixel's width: only the samples over it are tested.
+  const std::int32_t left_fx8 = std::int32_t(x) * kSubpixelOne;
+  const std::int32_t min_x = std::min({t.x_fx8[0], t.x_fx8[1], t.x_fx8[2]}) - left_fx8;
+  const std::int32_t max_x = std::max({t.x_fx8[0], t.x_fx8[1], t.x_fx8[2]}) - left_fx8;
+  crossing.k_begin = int(std::clamp<std::int32_t>(min_x, 0, kMaskSamples));
+  crossing.k_end = int(std::clamp<std::int32_t>(max_x, 0, kMaskSamples));
   return HWY_DYNAMIC_DISPATCH(SampleMaskCrossing)(crossing);
 }
 
