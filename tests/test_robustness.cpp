@@ -4,6 +4,7 @@
 // triangle limit, and the warnings for what loads but draws nothing. The CLI view of the same
 // inputs is the bad-input corpus (test_bad_input_corpus.cpp).
 #include <covrast/error.hpp>
+#include <covrast/image.hpp>
 #include <covrast/scene.hpp>
 
 #include <sys/stat.h>
@@ -99,6 +100,32 @@ TEST_CASE("robust: read_whole_file reads regular files only, up to its limit", "
   CHECK(error == "the path contains a NUL byte");
   CHECK(covrast::detail::size_text(std::uint64_t(1) << 30) == "1 GiB");
   CHECK(covrast::detail::size_text(std::uint64_t(1) << 26) == "64 MiB");
+}
+
+TEST_CASE("robust: every reader names a directory and a device alike", "[robust]") {
+  // One reader (core/file_read.hpp) and one wording for what is not a regular file, whether
+  // a scene, a mesh, a glTF buffer, a texture or a PNG to compare is asked for.
+  TempDir dir("covrast-robust");
+  namespace cd = covrast::detail;
+  CHECK(cd::unreadable_kind(fs::status(dir.path())) == "Is a directory");
+  CHECK(cd::unreadable_kind(fs::status("/dev/zero")) == "not a regular file");
+  CHECK(cd::unreadable_kind(fs::status(dir / "missing.png")).empty());
+  write_text(dir / "ten.txt", "0123456789");
+  CHECK(cd::unreadable_kind(fs::status(dir / "ten.txt")).empty());
+  const auto message = [](const auto& read) -> std::string {
+    try {
+      read();
+    } catch (const covrast::InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  CHECK(message([&] { covrast::read_image(dir.path(), "t.png"); }) ==
+        "t.png: cannot read image: Is a directory");
+  CHECK(message([&] { covrast::read_image("/dev/zero", "z.png"); }) ==
+        "z.png: cannot read image: not a regular file");
+  CHECK(message([&] { covrast::read_png(dir.path()); }) ==
+        dir.path().string() + ": cannot read PNG: Is a directory");
 }
 
 TEST_CASE("robust: an OBJ face of many corners is linear, past the limit an error", "[robust]") {

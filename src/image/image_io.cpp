@@ -22,6 +22,8 @@
 //    Rows use filter Sub, which compresses smooth depth far better than None.
 //  - .pfm: "Pf" greyscale Portable Float Map, scale -1.0 (little-endian float32), rows stored
 //    bottom-to-top as the PFM format specifies.
+#include "core/file_read.hpp"
+
 #include <covrast/image.hpp>
 
 #include <spng.h>
@@ -279,8 +281,8 @@ void write_png(const Image& image, const std::filesystem::path& path,
 std::vector<PngText> read_png_text(const std::filesystem::path& path) {
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    throw InputError(path.string() + ": cannot read PNG: not a regular file");
+  if (const std::string kind = detail::unreadable_kind(status); !ec && !kind.empty()) {
+    throw InputError(path.string() + ": cannot read PNG: " + kind);
   }
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) {
@@ -338,8 +340,9 @@ Image read_png(const std::filesystem::path& path) {
   };
   std::error_code ec;
   const auto status = std::filesystem::status(path, ec);
-  if (!ec && std::filesystem::exists(status) && !std::filesystem::is_regular_file(status)) {
-    return fail("not a regular file");  // a FIFO or device would block or never end
+  // A FIFO or device would block or never end.
+  if (const std::string kind = detail::unreadable_kind(status); !ec && !kind.empty()) {
+    return fail(kind);
   }
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) return fail(errno_message(errno));
@@ -539,38 +542,15 @@ RgbaImage read_image(const std::filesystem::path& path, const std::string& name)
   const auto fail = [&](const std::string& why) {
     throw InputError(name + ": cannot read image: " + why);
   };
-  // A path string with an embedded NUL would quietly open its prefix.
-  if (path.native().find('\0') != std::string::npos) fail("the path contains a NUL byte");
-  // O_NONBLOCK: opening a FIFO must not wait for a writer; fstat on the opened file then
-  // refuses what is not a regular file and, before a byte is read, a file over the limit
-  // (issue 28: a file near 1 GiB was read in full, into a growing buffer, before its size
-  // was checked).
-  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
-  if (fd < 0) fail(errno_message(errno));
-  const std::unique_ptr<int, void (*)(int*)> closer(new int(fd), [](int* f) {
-    ::close(*f);
-    delete f;
-  });
-  struct stat info {};
-  if (::fstat(fd, &info) != 0) fail(errno_message(errno));
-  if (!S_ISREG(info.st_mode)) fail("not a regular file");
   // Bounded: an image over the limits is refused from its header anyway, and no PNG or JPEG
-  // of at most kMaxPngPixels needs more than this many bytes.
+  // of at most kMaxPngPixels needs more than this many bytes. The reader refuses what is not
+  // a regular file and, before a byte is read, a file over the limit (issue 28: a file near
+  // 1 GiB was read in full, into a growing buffer, before its size was checked).
   constexpr std::uint64_t kMaxImageFileBytes = std::uint64_t(1) << 30;
-  const auto size = static_cast<std::uint64_t>(info.st_size);
-  if (size > kMaxImageFileBytes) {
-    fail("file of " + std::to_string(size) + " bytes is larger than the 1 GiB limit");
+  Bytes bytes;
+  if (std::string error; !detail::read_whole_file(path, bytes, error, kMaxImageFileBytes)) {
+    fail(error);
   }
-  Bytes bytes(static_cast<std::size_t>(size));
-  std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t got = ::read(fd, bytes.data() + done, bytes.size() - done);
-    if (got < 0 && errno == EINTR) continue;
-    if (got < 0) fail(errno_message(errno));
-    if (got == 0) break;  // the file shrank meanwhile: decode what is there
-    done += static_cast<std::size_t>(got);
-  }
-  bytes.resize(done);
   return decode_image(bytes.data(), bytes.size(), name);
 }
 

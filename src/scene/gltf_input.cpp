@@ -257,8 +257,8 @@ void check_buffer_file(const std::string& uri, std::uint64_t byte_length, const 
   const std::filesystem::path path = base_dir / decoded;
   const auto status = std::filesystem::status(path, ec);
   if (ec) fail(name, what + ": cannot open " + shown_uri + ": " + ec.message());
-  if (!std::filesystem::is_regular_file(status)) {
-    fail(name, what + ": cannot open " + shown_uri + ": not a regular file");
+  if (const std::string kind = unreadable_kind(status); !kind.empty()) {
+    fail(name, what + ": cannot open " + shown_uri + ": " + kind);
   }
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   if (ec) fail(name, what + ": cannot open " + shown_uri + ": " + ec.message());

@@ -5,6 +5,8 @@
 
 #include <covrast/scene.hpp>
 
+#include "core/file_read.hpp"
+
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
@@ -57,17 +59,12 @@ struct LoadedMesh {
   std::vector<FileLight> lights;
 };
 
-/// Reads a whole regular file of at most `max_bytes`. On failure returns false and sets
-/// `error` to the reason (the system's, e.g. "No such file or directory", or "not a regular
-/// file", a size over the limit, a NUL byte in the path). Never blocks on a FIFO or device.
+/// core/file_read.hpp's readers, with the loaders' limit as the default (a later
+/// declaration may add default arguments).
 bool read_whole_file(const std::filesystem::path& path, std::string& contents, std::string& error,
                      std::uint64_t max_bytes = kMaxInputFileBytes);
-/// The same into bytes (tinygltf's buffers and images: read once, not copied).
 bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned char>& contents,
                      std::string& error, std::uint64_t max_bytes = kMaxInputFileBytes);
-
-/// "1 GiB", "64 MiB" or "N bytes".
-std::string size_text(std::uint64_t bytes);
 
 /// The deepest nesting of arrays and objects in JSON text (strings and comments skipped),
 /// scanning no further than the first place where it exceeds `limit`; there `offset` is set
