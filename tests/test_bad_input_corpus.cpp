@@ -684,6 +684,35 @@ std::vector<Case> gltf_cases() {
                 "m.gltf: nodes[0].mesh: expected an index"),
       gltf_case("gltf: scene nodes strings", with([](json& d) { d["scenes"][0]["nodes"] = {"0"}; }),
                 "m.gltf: scenes[0].nodes: expected an array of indices"),
+      // Issue 26: what the Khronos validator calls errors, each named by its JSON path (the
+      // fields covrast uses) or a warning that --strict makes an error (one it ignores).
+      gltf_case(
+          "gltf: normalTexture.scale a string", with([](json& d) {
+            d["materials"] = json::array({{{"normalTexture", {{"index", 0}, {"scale", "1"}}}}});
+          }),
+          "m.gltf: materials[0].normalTexture.scale: expected a number, got \"1\""),
+      gltf_case("gltf: texture index -1", with([](json& d) {
+                  d["materials"] = json::array(
+                      {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", -1}}}}}}});
+                }),
+                "m.gltf: materials[0].pbrMetallicRoughness.baseColorTexture.index: expected an "
+                "index (an integer >= 0), got -1"),
+      gltf_case("gltf: baseColorFactor of three numbers", with([](json& d) {
+                  d["materials"] =
+                      json::array({{{"pbrMetallicRoughness", {{"baseColorFactor", {1, 1, 1}}}}}});
+                }),
+                "m.gltf: materials[0].pbrMetallicRoughness.baseColorFactor: expected 4 numbers, "
+                "got 3"),
+      gltf_case("gltf: emissiveFactor a number", with([](json& d) {
+                  d["materials"] = json::array({{{"emissiveFactor", 1}}});
+                }),
+                "m.gltf: materials[0].emissiveFactor: expected an array of numbers, got 1"),
+      gltf_case("gltf: texture source a string", with([](json& d) {
+                  d["textures"] = json::array({{{"source", "0"}}});
+                }),
+                "m.gltf: textures[0].source: expected an index"),
+      gltf_case("gltf: mesh name a number", with([](json& d) { d["meshes"][0]["name"] = 7; }),
+                "m.gltf: meshes[0].name: expected a string, got 7 (ignored)", "m.gltf", true),
       gltf_case("gltf: matrix of strings",
                 with([](json& d) { d["nodes"][0]["matrix"] = json::array({"1"}); }),
                 "m.gltf: nodes[0].matrix: expected an array of numbers"),

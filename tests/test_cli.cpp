@@ -367,6 +367,28 @@ TEST_CASE("cli: info describes a good scene", "[cli]") {
   check_one_error_line(r);
 }
 
+TEST_CASE("cli: info takes a model file as render does", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  // A model path is framed by the default camera, as `covrast render MODEL` frames it.
+  RunResult r = run_cli(dir, {"info", (dir / "tri.obj").string(), "--json"});
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const nlohmann::json info = nlohmann::json::parse(r.out);
+  CHECK(info.at("triangles") == 1);
+  CHECK(info.at("vertices") == 3);
+  REQUIRE(info.at("meshes").size() == 1);
+  CHECK(info.at("meshes")[0].at("source").get<std::string>().find("tri.obj") != std::string::npos);
+
+  // A model that is not valid is exit 2 naming it, not a JSON syntax error about the scene.
+  write_text(dir / "bad.obj", "v 0 0 0\nf 1 2 3\n");
+  r = run_cli(dir, {"info", (dir / "bad.obj").string()});
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("bad.obj") != std::string::npos);
+  CHECK(r.err.find("JSON") == std::string::npos);
+  check_one_error_line(r);
+}
+
 TEST_CASE("cli: compare exit codes follow the thresholds", "[cli]") {
   TempDir dir;
   const covrast::Image a = test_image(9, 7, 1);

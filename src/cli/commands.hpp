@@ -3,6 +3,7 @@
 #pragma once
 
 #include <covrast/error.hpp>
+#include <covrast/scene.hpp>
 
 #include <CLI/CLI.hpp>
 
@@ -87,6 +88,11 @@ int run_render(const RenderArgs& args);
 int run_info(const InfoArgs& args);
 int run_compare(const CompareArgs& args);
 int run_test(TestArgs args);
+
+/// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
+/// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x
+/// `height` when given (> 0), else 640x360.
+Scene load_scene_or_model(const std::string& path, int width = 0, int height = 0);
 
 /// Throws InputError unless `path` could be created or replaced: its directory exists, is a
 /// directory and is writable, the path is not a directory, and its extension (lower case) is

@@ -200,15 +200,20 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
 CLI::App* add_info_command(CLI::App& app, InfoArgs& args) {
   CLI::App* sub = app.add_subcommand(
       "info",
-      "Load a scene and describe it: image size, background, camera, meshes (source, "
-      "triangles, vertices, colour source), totals, world-space bounding box and warnings.");
-  sub->add_option("scene", args.scene, "Scene file (JSON)")->required()->type_name("SCENE.json");
+      "Load a scene, or a mesh file as render frames it, and describe it: image size, "
+      "background, camera, meshes (source, triangles, vertices, colour source), totals, "
+      "world-space bounding box and warnings.");
+  sub->add_option("scene", args.scene,
+                  "Scene file (JSON), or a mesh file (.obj, .gltf, .glb) described as 'covrast "
+                  "render' frames it without a scene file")
+      ->required()
+      ->type_name("SCENE.json|MODEL");
   sub->add_flag("--json", args.json, "Print one JSON line instead of text");
   return sub;
 }
 
 int run_info(const InfoArgs& args) {
-  const Scene scene = load_scene(args.scene);
+  const Scene scene = load_scene_or_model(args.scene);
   const Bounds bounds = world_bounds(scene);
   std::size_t total_vertices = 0;
   for (const MeshInstance& instance : scene.meshes) total_vertices += vertex_count(instance);

@@ -145,18 +145,6 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
   return sub;
 }
 
-namespace {
-
-/// A mesh file by its extension (any case): rendered without a scene file (load_mesh_scene).
-bool is_mesh_file(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".obj" || ext == ".gltf" || ext == ".glb";
-}
-
-}  // namespace
-
 int run_render(const RenderArgs& args) {
   RenderOptions options;
   options.mode = parse_render_mode(args.mode);
@@ -175,10 +163,7 @@ int run_render(const RenderArgs& args) {
   check_output_path(args.output, {".png"});
   if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});
 
-  const Scene scene = is_mesh_file(args.scene)
-                          ? load_mesh_scene(args.scene, options.width > 0 ? options.width : 640,
-                                            options.height > 0 ? options.height : 360)
-                          : load_scene(args.scene);
+  const Scene scene = load_scene_or_model(args.scene, options.width, options.height);
   if (args.strict && !scene.warnings.empty()) {
     // The error line first (main prints the warnings after it).
     const std::size_t count = scene.warnings.size();

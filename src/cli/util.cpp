@@ -19,6 +19,23 @@
 
 namespace covrast::cli {
 
+namespace {
+
+/// A mesh file by its extension (any case).
+bool is_mesh_file(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".obj" || ext == ".gltf" || ext == ".glb";
+}
+
+}  // namespace
+
+Scene load_scene_or_model(const std::string& path, int width, int height) {
+  if (!is_mesh_file(path)) return load_scene(path);
+  return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360);
+}
+
 void check_output_path(const std::filesystem::path& path,
                        const std::vector<std::string_view>& extensions) {
   namespace fs = std::filesystem;

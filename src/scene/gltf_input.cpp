@@ -21,12 +21,43 @@ namespace {
 using nlohmann::json;
 
 /// What a field of a glTF object must be (glTF 2.0 JSON schema, for the fields covrast reads).
-enum class Kind { Index, Count, Integer, String, Bool, Object, Array, IndexArray, NumberArray };
+/// Name: a string whose wrong type is a warning, not an error, as covrast does not use it.
+enum class Kind {
+  Index,
+  Count,
+  Integer,
+  Number,
+  String,
+  Name,
+  Bool,
+  Object,
+  Array,
+  IndexArray,
+  NumberArray
+};
 
 struct Field {
   const char* key;
   Kind kind;
+  /// NumberArray: the number of elements the schema requires (0: any).
+  std::size_t length = 0;
+  /// Object: the fields of the object, checked the same way (null: none).
+  const std::vector<Field>* fields = nullptr;
 };
+
+/// textureInfo, normalTextureInfo and occlusionTextureInfo (glTF 2.0, 5.22-5.24).
+const std::vector<Field> kTextureInfoFields = {{"index", Kind::Index},
+                                               {"texCoord", Kind::Count},
+                                               {"scale", Kind::Number},
+                                               {"strength", Kind::Number},
+                                               {"extensions", Kind::Object}};
+/// material.pbrMetallicRoughness (glTF 2.0, 5.19).
+const std::vector<Field> kPbrFields = {
+    {"baseColorFactor", Kind::NumberArray, 4},
+    {"metallicFactor", Kind::Number},
+    {"roughnessFactor", Kind::Number},
+    {"baseColorTexture", Kind::Object, 0, &kTextureInfoFields},
+    {"metallicRoughnessTexture", Kind::Object, 0, &kTextureInfoFields}};
 
 /// The top-level arrays whose elements covrast reads, and the fields it reads of each.
 struct Section {
@@ -43,14 +74,17 @@ const std::vector<Section>& sections() {
         {"count", Kind::Count},
         {"type", Kind::String},
         {"normalized", Kind::Bool},
-        {"sparse", Kind::Object}}},
+        {"sparse", Kind::Object},
+        {"name", Kind::Name}}},
       {"bufferViews",
        {{"buffer", Kind::Index},
         {"byteOffset", Kind::Count},
         {"byteLength", Kind::Count},
-        {"byteStride", Kind::Count}}},
-      {"buffers", {{"byteLength", Kind::Count}, {"uri", Kind::String}}},
-      {"meshes", {{"primitives", Kind::Array}, {"weights", Kind::NumberArray}}},
+        {"byteStride", Kind::Count},
+        {"name", Kind::Name}}},
+      {"buffers", {{"byteLength", Kind::Count}, {"uri", Kind::String}, {"name", Kind::Name}}},
+      {"meshes",
+       {{"primitives", Kind::Array}, {"weights", Kind::NumberArray}, {"name", Kind::Name}}},
       {"nodes",
        {{"children", Kind::IndexArray},
         {"mesh", Kind::Index},
@@ -61,15 +95,40 @@ const std::vector<Section>& sections() {
         {"rotation", Kind::NumberArray},
         {"scale", Kind::NumberArray},
         {"weights", Kind::NumberArray},
-        {"extensions", Kind::Object}}},
-      {"scenes", {{"nodes", Kind::IndexArray}}},
-      {"materials", {{"pbrMetallicRoughness", Kind::Object}, {"doubleSided", Kind::Bool}}},
-      {"cameras", {{"type", Kind::String}}},
-      {"skins", {{"joints", Kind::IndexArray}, {"inverseBindMatrices", Kind::Index}}},
-      {"images", {{"uri", Kind::String}, {"bufferView", Kind::Index}}},
-      {"textures", {}},
-      {"samplers", {}},
-      {"animations", {}},
+        {"extensions", Kind::Object},
+        {"name", Kind::Name}}},
+      {"scenes", {{"nodes", Kind::IndexArray}, {"name", Kind::Name}}},
+      {"materials",
+       {{"pbrMetallicRoughness", Kind::Object, 0, &kPbrFields},
+        {"normalTexture", Kind::Object, 0, &kTextureInfoFields},
+        {"occlusionTexture", Kind::Object, 0, &kTextureInfoFields},
+        {"emissiveTexture", Kind::Object, 0, &kTextureInfoFields},
+        {"emissiveFactor", Kind::NumberArray, 3},
+        {"alphaMode", Kind::String},
+        {"alphaCutoff", Kind::Number},
+        {"doubleSided", Kind::Bool},
+        {"extensions", Kind::Object},
+        {"name", Kind::Name}}},
+      {"cameras", {{"type", Kind::String}, {"name", Kind::Name}}},
+      {"skins",
+       {{"joints", Kind::IndexArray}, {"inverseBindMatrices", Kind::Index}, {"name", Kind::Name}}},
+      {"images",
+       {{"uri", Kind::String},
+        {"bufferView", Kind::Index},
+        {"mimeType", Kind::String},
+        {"name", Kind::Name}}},
+      {"textures",
+       {{"sampler", Kind::Index},
+        {"source", Kind::Index},
+        {"extensions", Kind::Object},
+        {"name", Kind::Name}}},
+      {"samplers",
+       {{"magFilter", Kind::Integer},
+        {"minFilter", Kind::Integer},
+        {"wrapS", Kind::Integer},
+        {"wrapT", Kind::Integer},
+        {"name", Kind::Name}}},
+      {"animations", {{"name", Kind::Name}}},
   };
   return kSections;
 }
@@ -103,7 +162,10 @@ bool has_kind(const json& value, Kind kind) {
       return is_index(value);
     case Kind::Integer:
       return value.is_number_integer();
+    case Kind::Number:
+      return value.is_number();
     case Kind::String:
+    case Kind::Name:
       return value.is_string();
     case Kind::Bool:
       return value.is_boolean();
@@ -128,7 +190,10 @@ const char* kind_text(Kind kind) {
       return "an integer >= 0";
     case Kind::Integer:
       return "an integer";
+    case Kind::Number:
+      return "a number";
     case Kind::String:
+    case Kind::Name:
       return "a string";
     case Kind::Bool:
       return "true or false";
@@ -144,27 +209,39 @@ const char* kind_text(Kind kind) {
   return "";
 }
 
+/// Checks the fields of `object` at JSON path `path`: a wrong type of a field covrast uses is
+/// an InputError; of one it ignores (Kind::Name), a line in `warn`.
 void check_fields(const json& object, const std::vector<Field>& fields, const std::string& path,
-                  const std::string& name) {
+                  const std::string& name, std::string& warn) {
   if (!object.is_object()) fail(name, path + ": expected an object, got " + shown(object));
   for (const Field& field : fields) {
     const auto it = object.find(field.key);
-    if (it != object.end() && !has_kind(*it, field.kind)) {
-      fail(name,
-           path + "." + field.key + ": expected " + kind_text(field.kind) + ", got " + shown(*it));
+    if (it == object.end()) continue;
+    const std::string where = path + "." + field.key;
+    if (!has_kind(*it, field.kind)) {
+      const std::string problem =
+          where + ": expected " + kind_text(field.kind) + ", got " + shown(*it);
+      if (field.kind != Kind::Name) fail(name, problem);
+      warn += problem + " (ignored)\n";
+      continue;
     }
+    if (field.length != 0 && it->size() != field.length) {
+      fail(name, where + ": expected " + std::to_string(field.length) + " numbers, got " +
+                     std::to_string(it->size()));
+    }
+    if (field.fields != nullptr) check_fields(*it, *field.fields, where, name, warn);
   }
 }
 
 /// The JSON types of every field covrast reads (tinygltf would skip a wrong one silently).
-void check_schema(const json& root, const std::string& name) {
+void check_schema(const json& root, const std::string& name, std::string& warn) {
   if (!root.is_object()) fail(name, "expected a JSON object at the top level");
   check_fields(root,
                {{"asset", Kind::Object},
                 {"scene", Kind::Index},
                 {"extensionsUsed", Kind::Array},
                 {"extensionsRequired", Kind::Array}},
-               "glTF", name);
+               "glTF", name, warn);
   for (const Section& section : sections()) {
     const auto it = root.find(section.key);
     if (it == root.end()) continue;
@@ -173,13 +250,13 @@ void check_schema(const json& root, const std::string& name) {
     }
     for (std::size_t i = 0; i < it->size(); ++i) {
       const std::string path = std::string(section.key) + "[" + std::to_string(i) + "]";
-      check_fields((*it)[i], section.fields, path, name);
+      check_fields((*it)[i], section.fields, path, name, warn);
       if (std::strcmp(section.key, "meshes") != 0) continue;
       const auto primitives = (*it)[i].find("primitives");
       if (primitives == (*it)[i].end()) continue;
       for (std::size_t p = 0; p < primitives->size(); ++p) {
         check_fields((*primitives)[p], primitive_fields(),
-                     path + ".primitives[" + std::to_string(p) + "]", name);
+                     path + ".primitives[" + std::to_string(p) + "]", name, warn);
       }
     }
   }
@@ -389,7 +466,7 @@ void check_gltf_input(std::string_view bytes, const std::string& name,
   } catch (const json::exception&) {
     return;  // a syntax error: tinygltf reports it with its line and column
   }
-  check_schema(root, name);
+  check_schema(root, name, warn);
   check_buffers(root, name, base_dir);
   check_light_ranges(root, name, warn);
 }
