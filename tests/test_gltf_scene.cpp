@@ -6,6 +6,8 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
+#include "core/srgb8.hpp"
+
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
 
@@ -324,7 +326,28 @@ const char* kCubeObj =
 
 }  // namespace
 
-TEST_CASE("a mesh file without a scene: framed from +z and lit by the default rig",
+namespace {
+
+/// Irradiance of the studio environment on a surface facing n, summed texel by texel:
+/// sum_t L_t max(0, n . d_t) Omega_t (docs/environments.md).
+glm::dvec3 studio_irradiance(const glm::dvec3& n) {
+  const covrast::EnvironmentMap& map = *covrast::studio_environment();
+  glm::dvec3 e(0.0);
+  for (int y = 0; y < map.height; ++y) {
+    const double omega = 2.0 * kPi / map.width *
+                         (std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
+    for (int x = 0; x < map.width; ++x) {
+      const glm::dvec3 d =
+          covrast::environment_direction((x + 0.5) / map.width, (y + 0.5) / map.height);
+      e += glm::dvec3(map.texel(x, y)) * (std::max(0.0, glm::dot(n, d)) * omega);
+    }
+  }
+  return e;
+}
+
+}  // namespace
+
+TEST_CASE("a mesh file without a scene: framed from +z and lit by the studio environment",
           "[cli][automatic]") {
   TempDir dir;
   const fs::path cube = dir.write("cube.obj", kCubeObj);
@@ -341,21 +364,20 @@ TEST_CASE("a mesh file without a scene: framed from +z and lit by the default ri
   CHECK(scene.camera.fovy_deg == 40.0);
   CHECK(scene.camera.near == Approx(distance - 1.5 * std::sqrt(3.0)));
   CHECK(scene.camera.far == Approx(distance + 1.5 * std::sqrt(3.0)));
-  // The rig, with the directional intensities divided by pi for OBJ's lambert.
+  // No lights: the built-in studio environment, unturned, at intensity 1.
   REQUIRE(scene.lit);
-  REQUIRE(scene.lights.size() == 3);
-  CHECK(scene.lights[0].type == LightType::Directional);
-  CHECK(scene.lights[0].intensity == Approx(3.0 / kPi));
-  CHECK(scene.lights[1].intensity == Approx(1.0 / kPi));
-  CHECK(scene.lights[2].type == LightType::Ambient);
-  CHECK(scene.lights[2].intensity == 0.25);
+  CHECK(scene.lights.empty());
+  REQUIRE(scene.environment.has_value());
+  CHECK(scene.environment->map == covrast::studio_environment());
+  CHECK(scene.environment->rotation_deg == 0.0);
+  CHECK(scene.environment->intensity == 1.0);
   // A tall image: the horizontal half angle is the smaller one.
   const covrast::Scene tall = covrast::load_mesh_scene(cube, 20, 80);
   const double half_h = std::atan(std::tan(20.0 * kPi / 180.0) * 0.25);
   CHECK(tall.camera.eye.z == Approx(1.05 * std::sqrt(3.0) / std::sin(half_h)).epsilon(1e-12));
 
   // Through the command line: the cube lies inside the image, with background all round it,
-  // and its front face (facing the camera, lit by key and fill) is lighter than the ambient.
+  // and its front face (facing the camera, lambert) is base x E(+z) / pi.
   const auto result = covrast::test::run_cli_in(
       dir.path(), {"render", "cube.obj", "-o", "out.png", "--size", "64x48"}, true);
   REQUIRE(result.exit_code == 0);
@@ -371,8 +393,12 @@ TEST_CASE("a mesh file without a scene: framed from +z and lit by the default ri
     }
   }
   CHECK(border_not_background == 0);
-  // The front face: 0.25 + (3 x 0.572 + (0.8, 0.85, 1) x 0.620) / pi = 0.95 .. 0.99.
-  for (int c = 0; c < 3; ++c) CHECK(int(image.pixel(32, 24)[c]) > 240);
+  const glm::dvec3 front =
+      glm::dvec3(scene.meshes[0].color_linear) * studio_irradiance({0.0, 0.0, 1.0}) / kPi;
+  for (int c = 0; c < 3; ++c) {
+    CHECK(std::abs(int(image.pixel(32, 24)[c]) -
+                   int(covrast::detail::encode_srgb8(float(front[c])))) <= 1);
+  }
   const auto missing =
       covrast::test::run_cli_in(dir.path(), {"render", "gone.glb", "-o", "x.png"}, true);
   CHECK(missing.exit_code == 2);
@@ -395,12 +421,12 @@ TEST_CASE("a glTF file without a scene: its camera and its lights when it has th
   REQUIRE(scene.lights.size() == 3);  // the file's, no rig
   CHECK(scene.lights[1].type == LightType::Point);
   CHECK(scene.lights[1].position == glm::dvec3(1, 0, 2));
-  // Without lights and camera: the rig at pbr intensities, and the framing camera.
+  CHECK_FALSE(scene.environment.has_value());
+  // Without lights and camera: the studio environment, and the framing camera.
   const covrast::Scene plain =
       covrast::load_mesh_scene(dir.write("plain.glb", square_file().glb()));
-  REQUIRE(plain.lights.size() == 3);
-  CHECK(plain.lights[0].intensity == 3.0);
-  CHECK(plain.lights[1].intensity == 1.0);
+  CHECK(plain.lights.empty());
+  CHECK(plain.environment.has_value());
   CHECK(plain.camera.target == glm::dvec3(0, 0, 0));
   CHECK(plain.camera.eye.z == Approx(1.05 * std::sqrt(2.0) / std::sin(20.0 * kPi / 180.0)));
   CHECK_THROWS_WITH(covrast::load_mesh_scene(dir.write("a.stl", "solid")),

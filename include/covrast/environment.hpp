@@ -66,3 +66,12 @@ inline glm::dvec2 environment_uv(const glm::dvec3& d) {
 }
 
 }  // namespace covrast
+
+namespace covrast {
+
+/// The built-in neutral studio environment (docs/environments.md has its definition): a
+/// 256 x 128 map of a grey room, brighter above than below, with three soft white box lights
+/// (key, fill and rim). The same texels on every machine; no file needed.
+std::shared_ptr<const EnvironmentMap> studio_environment();
+
+}  // namespace covrast

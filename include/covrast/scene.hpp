@@ -5,6 +5,7 @@
 // here knows about pixels except the requested image size.
 #pragma once
 
+#include <covrast/environment.hpp>
 #include <covrast/error.hpp>
 #include <covrast/texture.hpp>
 
@@ -217,6 +218,8 @@ struct Scene {
   /// shows); without one every mesh renders unlit, exactly as before lighting existed.
   bool lit = false;
   std::vector<Light> lights;
+  /// Image-based lighting (docs/environments.md); lights the lit meshes of a lit scene.
+  std::optional<EnvironmentLight> environment;
   /// Triangles dropped at load time because a vertex had a NaN or infinite coordinate.
   std::size_t dropped_nonfinite_triangles = 0;
   /// One line each, e.g. "meshes/a.obj: dropped 3 triangles with NaN/Inf coordinates".

@@ -4,6 +4,7 @@
 // differs (pixel centre clamped into the triangle for coverage and msaa, every sample for
 // ssaa and reference).
 #include "core/shading.hpp"
+#include "core/environment_lighting.hpp"
 #include "core/shading_inputs.hpp"
 
 #include <algorithm>
@@ -65,6 +66,39 @@ glm::dvec3 diffuse_sum(const ShadingContext& c, double occlusion, const glm::dve
     e += in.irradiance * std::max(0.0, glm::dot(n, in.l));
   }
   return base * e;
+}
+
+/// The environment's diffuse light for the Lambert and Blinn-Phong models: a Lambertian
+/// surface's base x E(n) / pi, x occlusion. (Their punctual lights keep covrast's older
+/// convention without 1 / pi, docs/shading.md.)
+glm::dvec3 environment_diffuse(const ShadingContext& c, double occlusion, const glm::dvec3& base,
+                               const glm::dvec3& n) {
+  if (c.environment == nullptr || n == glm::dvec3(0.0)) return glm::dvec3(0.0);
+  return base * c.environment->irradiance(n) * (occlusion / kPi);
+}
+
+/// The environment's light for the glTF BRDF (core/environment_lighting.hpp):
+///   occlusion x (c_diff (1 - f0) (E / pi - E_s) + f0 A + (1 - f0) B).
+glm::dvec3 environment_pbr(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& n,
+                           const glm::dvec3& v) {
+  const EnvironmentLighting* environment = s.context->environment;
+  if (environment == nullptr || n == glm::dvec3(0.0)) return glm::dvec3(0.0);
+  const EnvironmentIntegrals e = environment->integrals(n, v, s.roughness);
+  const glm::dvec3 c_diff = base * (1.0 - s.metallic);
+  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - s.metallic) + base * s.metallic;
+  const glm::dvec3 one_minus_f0 = glm::dvec3(1.0) - f0;
+  glm::dvec3 sum =
+      s.occlusion * (c_diff * one_minus_f0 * (e.irradiance * (1.0 / kPi) - e.irradiance_schlick) +
+                     f0 * e.specular + one_minus_f0 * e.specular_schlick);
+  // The suns as the directional lights they are, occluded like the rest of the environment
+  // (as the viewers, which do not take suns out, occlude them).
+  for (const EnvironmentSun& sun : environment->suns()) {
+    const double n_dot_l = glm::dot(n, sun.to_light);
+    if (!(n_dot_l > 0.0)) continue;
+    sum += pbr_brdf(base, s.metallic, s.roughness, n, v, sun.to_light) * sun.irradiance *
+           (n_dot_l * s.occlusion);
+  }
+  return sum;
 }
 
 /// Blinn (1977) highlight: sum_i specular x E_i x max(0, n . h_i)^shininess where n . l_i > 0,
@@ -147,13 +181,15 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
     case LitModel::Unlit:
       return base;
     case LitModel::Lambert:
-      return diffuse_sum(c, s.occlusion, base, p, n) + s.emissive;
+      return diffuse_sum(c, s.occlusion, base, p, n) +
+             environment_diffuse(c, s.occlusion, base, n) + s.emissive;
     case LitModel::BlinnPhong:
-      return diffuse_sum(c, s.occlusion, base, p, n) + blinn_phong_highlights(s, p, n, v) +
+      return diffuse_sum(c, s.occlusion, base, p, n) +
+             environment_diffuse(c, s.occlusion, base, n) + blinn_phong_highlights(s, p, n, v) +
              s.emissive;
     case LitModel::Pbr:
     default:
-      return pbr_radiance(s, base, p, n, v) + s.emissive;
+      return pbr_radiance(s, base, p, n, v) + environment_pbr(s, base, n, v) + s.emissive;
   }
 }
 

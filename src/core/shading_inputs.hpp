@@ -34,6 +34,8 @@ struct PunctualLight {
   double cone_offset = 1.0;
 };
 
+class EnvironmentLighting;  // core/environment_lighting.hpp
+
 /// The frame's lights and eye: one per front end, shared by every lit triangle.
 struct ShadingContext {
   glm::dvec3 eye_world{0.0};
@@ -42,6 +44,8 @@ struct ShadingContext {
   glm::dvec3 to_eye{0.0, 0.0, 1.0};
   glm::dvec3 ambient{0.0};  ///< sum of the ambient lights' color x intensity
   std::vector<PunctualLight> lights;
+  /// The scene's environment, prepared (null: none); lights every lit model but Unlit.
+  const EnvironmentLighting* environment = nullptr;
 };
 
 /// A material's non-empty texture slots (pointers into the scene's Material; null: none).

@@ -329,6 +329,11 @@ void GeometryFrontEnd::prepare_lighting() {
     context_.orthographic = true;
     context_.to_eye = glm::normalize(scene_.camera.eye - scene_.camera.target);
   }
+  if (scene_.environment && scene_.environment->map && scene_.environment->map->width > 0 &&
+      scene_.environment->map->height > 0) {
+    environment_.emplace(*scene_.environment);
+    context_.environment = &*environment_;
+  }
   for (const Light& light : scene_.lights) {
     if (light.type == LightType::Ambient) {
       context_.ambient += glm::dvec3(light.color_linear) * light.intensity;

@@ -9,6 +9,7 @@
 // constructor in frontend.cpp for why that never changes the image).
 #pragma once
 
+#include "core/environment_lighting.hpp"
 #include "core/shading_inputs.hpp"
 #include "core/triangle_setup.hpp"
 
@@ -17,6 +18,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <vector>
 
 namespace covrast::detail {
@@ -290,6 +292,7 @@ class GeometryFrontEnd {
   // m, pointing at context_; chunk_shading_[c]: the records of chunk c, written
   // only by setup_chunk(c).
   ShadingContext context_;
+  std::optional<EnvironmentLighting> environment_;  ///< context_.environment points here
   /// Single-sided materials per instance (set_single_sided): 0 none, 1 all, 2 some, with
   /// single_sided_triangles_[instance] flagging each triangle then.
   void prepare_single_sided();

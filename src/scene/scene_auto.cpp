@@ -1,6 +1,6 @@
 // The parts of load_mesh_scene (scene_json.cpp) that a scene file would otherwise give: a
-// camera that frames the model and a default light rig (docs/scene-format.md, "Rendering a
-// mesh file without a scene"). The rig is scripts/gallery.py's.
+// camera that frames the model (docs/scene-format.md, "Rendering a mesh file without a
+// scene"); the light is the studio environment (scene/environment_studio.cpp).
 #include "scene/scene_internal.hpp"
 
 #include <algorithm>
@@ -41,23 +41,6 @@ Camera framing_camera(const Scene& scene) {
   camera.near = std::max(distance - 1.5 * radius, 1e-3 * distance);
   camera.far = distance + 1.5 * radius;
   return camera;
-}
-
-std::vector<Light> default_light_rig(bool pbr) {
-  const double scale = pbr ? 1.0 : 1.0 / std::numbers::pi;
-  Light key;
-  key.type = LightType::Directional;
-  key.direction = glm::dvec3(0.5, -0.7, -0.6);
-  key.intensity = 3.0 * scale;
-  Light fill;
-  fill.type = LightType::Directional;
-  fill.direction = glm::dvec3(-0.6, -0.2, -0.5);
-  fill.color_linear = glm::vec3(0.8f, 0.85f, 1.0f);
-  fill.intensity = 1.0 * scale;
-  Light ambient;
-  ambient.type = LightType::Ambient;
-  ambient.intensity = 0.25;
-  return {key, fill, ambient};
 }
 
 }  // namespace covrast::detail

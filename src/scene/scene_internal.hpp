@@ -108,11 +108,6 @@ void count_texture_texels(int width, int height, const std::string& name,
 /// sphere fits the view with a 5% margin (docs/scene-format.md).
 Camera framing_camera(const Scene& scene);
 
-/// load_mesh_scene's lights for a file without any: a key and a fill directional light and an
-/// ambient one; `pbr` keeps the pbr intensities, else the directional ones are divided by pi
-/// (lambert and blinn-phong have no 1/pi).
-std::vector<Light> default_light_rig(bool pbr);
-
 /// Removes every triangle that uses a vertex with a non-finite coordinate and sets such
 /// vertices to the origin (nothing references them any more). Returns the number removed.
 std::size_t drop_nonfinite_triangles(MeshData& mesh);

@@ -949,9 +949,8 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
   } else {
     scene.camera = detail::framing_camera(scene);
   }
-  if (scene.lights.empty()) {
-    for (const Light& light : detail::default_light_rig(gltf)) add_light(scene, light);
-  }
+  // A file without lights is lit as the viewers light it: by the built-in studio environment.
+  if (scene.lights.empty()) scene.environment = EnvironmentLight{studio_environment(), 0.0, 1.0};
   scene.lit = true;
   scene.source = mesh_path;
   warn_beyond_finite_range(scene);

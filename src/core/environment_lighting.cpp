@@ -1,0 +1,468 @@
+// Image-based lighting: the moment pyramid for the irradiance, the radiance pyramid and the
+// filtered GGX estimates for the rest (the formulas are in core/environment_lighting.hpp).
+#include "core/environment_lighting.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <numbers>
+
+namespace covrast::detail {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+/// The BRDF's smallest alpha, as in pbr_brdf (core/shading.cpp).
+constexpr double kMinAlpha = 1e-3;
+/// Finest moment cells: at most this many across (and half as many down). Cells the horizon
+/// cuts take max(0, n . m); their error is at most Omega_cell sin(radius) each.
+constexpr int kMomentCellsAcross = 128;
+/// GGX directions per shading point for A and B.
+constexpr int kSpecularSamples = 64;
+/// Uniform-light tables: n . v in [0, 1] and perceptual roughness in [0, 1], both at
+/// evenly spaced nodes; each entry from kTableSamples stratified directions.
+constexpr int kTableMuNodes = 64;
+constexpr int kTableRoughnessNodes = 32;
+constexpr int kTableSamples = 4096;
+/// A texel with at least this share of the map's power (luminance x solid angle) is a sun.
+constexpr double kSunPowerShare = 0.01;
+/// At most this many suns (the brightest); the rest stay in the map.
+constexpr std::size_t kMaxSuns = 16;
+
+double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
+
+int floor_pow2(int n) {
+  int p = 1;
+  while (p * 2 <= n) p *= 2;
+  return p;
+}
+
+/// Van der Corput radical inverse in base 2: the second Hammersley coordinate.
+double radical_inverse2(unsigned i) {
+  double inv = 0.5, r = 0.0;
+  while (i != 0) {
+    if ((i & 1U) != 0) r += inv;
+    inv *= 0.5;
+    i >>= 1U;
+  }
+  return r;
+}
+
+/// An orthonormal basis (t, b) around unit n: Duff et al., "Building an Orthonormal Basis,
+/// Revisited", JCGT 6(1), 2017.
+void tangent_frame(const glm::dvec3& n, glm::dvec3& t, glm::dvec3& b) {
+  const double sign = std::copysign(1.0, n.z);
+  const double a = -1.0 / (sign + n.z);
+  const double c = n.x * n.y * a;
+  t = glm::dvec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
+  b = glm::dvec3(c, sign + n.y * n.y * a, -n.y);
+}
+
+/// cos and sin of the azimuth 2 pi xi2 of the first `count` Hammersley points: the same for
+/// every shading point and roughness, so computed once.
+std::vector<glm::dvec2> hammersley_azimuths(int count) {
+  std::vector<glm::dvec2> azimuths;
+  for (int k = 0; k < count; ++k) {
+    const double phi = 2.0 * kPi * radical_inverse2(unsigned(k));
+    azimuths.push_back({std::cos(phi), std::sin(phi)});
+  }
+  return azimuths;
+}
+
+/// The half vector of GGX sample (xi1, azimuth) around n: cos(theta_h) = sqrt((1 - xi1) / (1 +
+/// (alpha^2 - 1) xi1)) samples D(h) (n . h) (Walter et al. 2007, eq. 35).
+glm::dvec3 ggx_half_vector(double xi1, const glm::dvec2& azimuth, double alpha2,
+                           const glm::dvec3& n, const glm::dvec3& t, const glm::dvec3& b,
+                           double& cos_h) {
+  cos_h = std::sqrt((1.0 - xi1) / (1.0 + (alpha2 - 1.0) * xi1));
+  const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
+  return t * (sin_h * azimuth.x) + b * (sin_h * azimuth.y) + n * cos_h;
+}
+
+/// V = 1 / ((n.l + sqrt(a2 + (1 - a2) (n.l)^2)) (n.v + sqrt(a2 + (1 - a2) (n.v)^2))), the
+/// specification's height-correlated Smith term, for n.l, n.v > 0.
+double smith_visibility(double n_dot_l, double n_dot_v, double alpha2) {
+  const double gl = n_dot_l + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_l * n_dot_l);
+  const double gv = n_dot_v + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_v * n_dot_v);
+  return 1.0 / (gl * gv);
+}
+
+double schlick5(double cos_theta) {
+  const double m = std::clamp(1.0 - cos_theta, 0.0, 1.0);
+  const double m2 = m * m;
+  return m2 * m2 * m;
+}
+
+/// The view direction with n . v = mu in the (x, z) plane of n = +Z.
+glm::dvec3 view_at(double mu) { return {std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu}; }
+
+struct UniformTables {
+  std::vector<double> schlick_diffuse;   ///< [mu]: int s (n.l)+ dl / pi
+  std::vector<double> specular;          ///< [r][mu]: int D V (n.l)+ dl
+  std::vector<double> specular_schlick;  ///< [r][mu]: int s D V (n.l)+ dl
+};
+
+/// The smallest n . v of the tables' first node (n . v = 0 has no reflection).
+constexpr double kTableMinMu = 1e-4;
+
+double table_mu(int i) { return std::max(kTableMinMu, double(i) / double(kTableMuNodes - 1)); }
+
+UniformTables build_uniform_tables() {
+  UniformTables tables;
+  tables.schlick_diffuse.resize(kTableMuNodes);
+  tables.specular.resize(std::size_t(kTableMuNodes) * kTableRoughnessNodes);
+  tables.specular_schlick.resize(tables.specular.size());
+  const glm::dvec3 n(0.0, 0.0, 1.0), t(1.0, 0.0, 0.0), b(0.0, 1.0, 0.0);
+  const std::vector<glm::dvec2> azimuths = hammersley_azimuths(kTableSamples);
+  // The GGX half vectors of each roughness node (they do not depend on the view), with
+  // n . h in w.
+  std::vector<std::vector<glm::dvec4>> half_vectors(kTableRoughnessNodes);
+  for (int j = 0; j < kTableRoughnessNodes; ++j) {
+    const double r = double(j) / double(kTableRoughnessNodes - 1);
+    const double alpha = std::max(r * r, kMinAlpha);
+    for (int k = 0; k < kTableSamples; ++k) {
+      double cos_h = 0.0;
+      const glm::dvec3 h = ggx_half_vector((k + 0.5) / kTableSamples, azimuths[std::size_t(k)],
+                                           alpha * alpha, n, t, b, cos_h);
+      half_vectors[std::size_t(j)].push_back(glm::dvec4(h, cos_h));
+    }
+  }
+  for (int i = 0; i < kTableMuNodes; ++i) {
+    const double mu = table_mu(i);
+    const glm::dvec3 v = view_at(mu);
+    // Cosine-distributed l (pdf (n.l) / pi): int s (n.l)+ dl / pi = mean of s.
+    double s_sum = 0.0;
+    for (int k = 0; k < kTableSamples; ++k) {
+      const double xi1 = (k + 0.5) / kTableSamples;
+      const double sin_l = std::sqrt(xi1), cos_l = std::sqrt(1.0 - xi1);
+      const glm::dvec2& azimuth = azimuths[std::size_t(k)];
+      const glm::dvec3 l(sin_l * azimuth.x, sin_l * azimuth.y, cos_l);
+      const glm::dvec3 h = glm::normalize(l + v);
+      s_sum += schlick5(std::abs(glm::dot(v, h)));
+    }
+    tables.schlick_diffuse[std::size_t(i)] = s_sum / kTableSamples;
+    for (int j = 0; j < kTableRoughnessNodes; ++j) {
+      const double r = double(j) / double(kTableRoughnessNodes - 1);
+      const double alpha = std::max(r * r, kMinAlpha), alpha2 = alpha * alpha;
+      double a_sum = 0.0, b_sum = 0.0;
+      for (const glm::dvec4& sample : half_vectors[std::size_t(j)]) {
+        const glm::dvec3 h(sample);
+        const double cos_h = sample.w;
+        const double v_dot_h = glm::dot(v, h);
+        if (!(v_dot_h > 0.0)) continue;
+        const glm::dvec3 l = h * (2.0 * v_dot_h) - v;
+        if (!(l.z > 0.0)) continue;
+        // f cos / pdf with pdf(l) = D (n.h) / (4 v.h): V (n.l) 4 (v.h) / (n.h).
+        const double w = smith_visibility(l.z, mu, alpha2) * l.z * 4.0 * v_dot_h / cos_h;
+        a_sum += w;
+        b_sum += w * schlick5(v_dot_h);
+      }
+      const std::size_t at = std::size_t(j) * kTableMuNodes + std::size_t(i);
+      tables.specular[at] = a_sum / kTableSamples;
+      tables.specular_schlick[at] = b_sum / kTableSamples;
+    }
+  }
+  return tables;
+}
+
+const UniformTables& uniform_tables() {
+  static const UniformTables tables = build_uniform_tables();  // thread-safe, once
+  return tables;
+}
+
+/// The solid angle of texel row y of an equirectangular map H rows high and W wide:
+/// (2 pi / W) (cos(phi0) - cos(phi1)), phi0 = pi y / H, phi1 = pi (y + 1) / H.
+double row_solid_angle(int y, int width, int height) {
+  return 2.0 * kPi / width *
+         (std::cos(kPi * y / double(height)) - std::cos(kPi * (y + 1) / double(height)));
+}
+
+}  // namespace
+
+std::array<double, 3> uniform_environment_integrals(double mu, double roughness) {
+  const UniformTables& tables = uniform_tables();
+  const double x = std::clamp(mu, 0.0, 1.0) * (kTableMuNodes - 1);
+  const double y = std::clamp(roughness, 0.0, 1.0) * (kTableRoughnessNodes - 1);
+  const int i0 = std::min(int(x), kTableMuNodes - 2),
+            j0 = std::min(int(y), kTableRoughnessNodes - 2);
+  const double fx = x - i0, fy = y - j0;
+  auto at = [&](const std::vector<double>& table, int i, int j) {
+    return table[std::size_t(j) * kTableMuNodes + std::size_t(i)];
+  };
+  auto bilerp = [&](const std::vector<double>& table) {
+    const double top = at(table, i0, j0) * (1.0 - fx) + at(table, i0 + 1, j0) * fx;
+    const double bottom = at(table, i0, j0 + 1) * (1.0 - fx) + at(table, i0 + 1, j0 + 1) * fx;
+    return top * (1.0 - fy) + bottom * fy;
+  };
+  const double s = tables.schlick_diffuse[std::size_t(i0)] * (1.0 - fx) +
+                   tables.schlick_diffuse[std::size_t(i0 + 1)] * fx;
+  return {s, bilerp(tables.specular), bilerp(tables.specular_schlick)};
+}
+
+EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
+  const EnvironmentMap& map = *light.map;
+  const int w = map.width, h = map.height;
+  const double rotation = light.rotation_deg * (kPi / 180.0);
+  cos_rotation_ = std::cos(rotation);
+  sin_rotation_ = std::sin(rotation);
+  intensity_ = light.intensity;
+  texel_solid_angle_ = 4.0 * kPi / (double(w) * double(h));
+
+  // Suns: the brightest texels by power, each at least kSunPowerShare of the total; they leave
+  // the map (set to zero in the copy the pyramids are built from).
+  std::vector<glm::vec3> texels = map.radiance_linear;
+  {
+    double total = 0.0;
+    struct Bright {
+      double power;
+      std::size_t index;
+    };
+    std::vector<Bright> bright;
+    for (int y = 0; y < h; ++y) {
+      const double omega = row_solid_angle(y, w, h);
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        const double power = luminance(glm::dvec3(texels[i])) * omega;
+        total += power;
+        bright.push_back({power, i});
+      }
+    }
+    std::sort(bright.begin(), bright.end(), [](const Bright& a, const Bright& b) {
+      return a.power != b.power ? a.power > b.power : a.index < b.index;
+    });
+    for (std::size_t k = 0; k < std::min(kMaxSuns, bright.size()); ++k) {
+      if (!(bright[k].power > 0.0) || bright[k].power < kSunPowerShare * total) break;
+      const int x = int(bright[k].index % std::size_t(w)),
+                y = int(bright[k].index / std::size_t(w));
+      const glm::dvec3 d = environment_direction((x + 0.5) / w, (y + 0.5) / h);
+      suns_.push_back({d, glm::dvec3(texels[bright[k].index]) * row_solid_angle(y, w, h)});
+      texels[bright[k].index] = glm::vec3(0.0f);
+    }
+  }
+
+  // Radiance pyramid: each level halves the previous (rounding up), texels averaged with
+  // their solid angles as weights.
+  radiance_.push_back({w, h, std::move(texels)});
+  while (radiance_.back().width > 1 || radiance_.back().height > 1) {
+    const RadianceLevel& fine = radiance_.back();
+    RadianceLevel coarse{(fine.width + 1) / 2, (fine.height + 1) / 2, {}};
+    coarse.texels.assign(std::size_t(coarse.width) * std::size_t(coarse.height), glm::vec3(0.0f));
+    for (int y = 0; y < coarse.height; ++y) {
+      for (int x = 0; x < coarse.width; ++x) {
+        glm::dvec3 sum(0.0);
+        double weight = 0.0;
+        for (int fy = 2 * y; fy < std::min(2 * y + 2, fine.height); ++fy) {
+          const double omega = row_solid_angle(fy, fine.width, fine.height);
+          for (int fx = 2 * x; fx < std::min(2 * x + 2, fine.width); ++fx) {
+            sum += glm::dvec3(
+                       fine.texels[std::size_t(fy) * std::size_t(fine.width) + std::size_t(fx)]) *
+                   omega;
+            weight += omega;
+          }
+        }
+        coarse.texels[std::size_t(y) * std::size_t(coarse.width) + std::size_t(x)] =
+            glm::vec3(weight > 0.0 ? sum / weight : glm::dvec3(0.0));
+      }
+    }
+    radiance_.push_back(std::move(coarse));
+  }
+
+  // Moment pyramid: the finest cells group whole texels; every coarser level merges 2 x 2.
+  const int cells_x = floor_pow2(std::min(w, kMomentCellsAcross));
+  const int cells_y = floor_pow2(std::min(h, kMomentCellsAcross / 2));
+  auto cell_geometry = [](MomentCell& cell, double u0, double u1, double v0, double v1) {
+    cell.centre = environment_direction(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    // The farthest point of a latitude-longitude rectangle from its centre is a corner.
+    double min_cos = 1.0;
+    for (double u : {u0, u1}) {
+      for (double v : {v0, v1}) {
+        min_cos = std::min(min_cos, glm::dot(cell.centre, environment_direction(u, v)));
+      }
+    }
+    const double radius = std::acos(std::clamp(min_cos, -1.0, 1.0)) + 1e-9;
+    // Wider than a hemisphere: never wholly above or below a horizon.
+    cell.sin_radius = radius < 0.5 * kPi ? std::sin(radius) : 2.0;
+  };
+  MomentLevel finest{cells_x, cells_y, {}};
+  finest.cells.resize(std::size_t(cells_x) * std::size_t(cells_y));
+  for (int y = 0; y < h; ++y) {
+    const double omega = row_solid_angle(y, w, h);
+    const int cy = int(std::int64_t(y) * cells_y / h);
+    for (int x = 0; x < w; ++x) {
+      const int cx = int(std::int64_t(x) * cells_x / w);
+      const glm::dvec3 d = environment_direction((x + 0.5) / w, (y + 0.5) / h) * omega;
+      const glm::dvec3 l(radiance_[0].texels[std::size_t(y) * std::size_t(w) + std::size_t(x)]);
+      MomentCell& cell = finest.cells[std::size_t(cy) * std::size_t(cells_x) + std::size_t(cx)];
+      for (int c = 0; c < 3; ++c) cell.m[std::size_t(c)] += d * l[c];
+    }
+  }
+  for (int cy = 0; cy < cells_y; ++cy) {
+    for (int cx = 0; cx < cells_x; ++cx) {
+      cell_geometry(finest.cells[std::size_t(cy) * std::size_t(cells_x) + std::size_t(cx)],
+                    double(cx) / cells_x, double(cx + 1) / cells_x, double(cy) / cells_y,
+                    double(cy + 1) / cells_y);
+    }
+  }
+  moments_.push_back(std::move(finest));
+  while (moments_.back().width > 2 && moments_.back().height > 1) {
+    const MomentLevel& fine = moments_.back();
+    MomentLevel coarse{fine.width / 2, fine.height / 2, {}};
+    coarse.cells.resize(std::size_t(coarse.width) * std::size_t(coarse.height));
+    for (int cy = 0; cy < coarse.height; ++cy) {
+      for (int cx = 0; cx < coarse.width; ++cx) {
+        MomentCell& cell =
+            coarse.cells[std::size_t(cy) * std::size_t(coarse.width) + std::size_t(cx)];
+        for (int k = 0; k < 4; ++k) {
+          const MomentCell& child =
+              fine.cells[std::size_t(2 * cy + k / 2) * std::size_t(fine.width) +
+                         std::size_t(2 * cx + k % 2)];
+          for (int c = 0; c < 3; ++c) cell.m[std::size_t(c)] += child.m[std::size_t(c)];
+        }
+        cell_geometry(cell, double(cx) / coarse.width, double(cx + 1) / coarse.width,
+                      double(cy) / coarse.height, double(cy + 1) / coarse.height);
+      }
+    }
+    moments_.push_back(std::move(coarse));
+  }
+  // The suns in the world frame: R_y(r) d, and x intensity.
+  for (EnvironmentSun& sun : suns_) {
+    const glm::dvec3 d = sun.to_light;
+    sun.to_light = {d.x * cos_rotation_ + d.z * sin_rotation_, d.y,
+                    -d.x * sin_rotation_ + d.z * cos_rotation_};
+    sun.irradiance *= intensity_;
+  }
+}
+
+glm::dvec3 EnvironmentLighting::to_map(const glm::dvec3& d) const {
+  // The inverse rotation R_y(-r): the map was turned by R_y(r) into the world.
+  return {d.x * cos_rotation_ - d.z * sin_rotation_, d.y,
+          d.x * sin_rotation_ + d.z * cos_rotation_};
+}
+
+glm::dvec3 EnvironmentLighting::irradiance(const glm::dvec3& n_world) const {
+  glm::dvec3 e = irradiance_without_suns(n_world);
+  for (const EnvironmentSun& sun : suns_) {
+    e += sun.irradiance * std::max(0.0, glm::dot(n_world, sun.to_light));
+  }
+  return e;
+}
+
+glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_world) const {
+  const glm::dvec3 n = to_map(n_world);
+  glm::dvec3 e(0.0);
+  // Depth-first over the cells the horizon cuts; (level, index) pairs.
+  struct Pending {
+    int level;
+    int index;
+  };
+  static thread_local std::vector<Pending> stack;  // reused: no allocation per point
+  stack.clear();
+  const int top = int(moments_.size()) - 1;
+  for (int i = 0; i < int(moments_[std::size_t(top)].cells.size()); ++i) stack.push_back({top, i});
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    const MomentLevel& level = moments_[std::size_t(p.level)];
+    const MomentCell& cell = level.cells[std::size_t(p.index)];
+    const double c = glm::dot(n, cell.centre);
+    if (c <= -cell.sin_radius) continue;  // wholly below the horizon
+    if (c >= cell.sin_radius || p.level == 0) {
+      // Wholly above: exact; a finest cell the horizon cuts: max(0, n . m).
+      for (int k = 0; k < 3; ++k) {
+        const double part = glm::dot(n, cell.m[std::size_t(k)]);
+        e[k] += c >= cell.sin_radius ? part : std::max(0.0, part);
+      }
+      continue;
+    }
+    const int cx = p.index % level.width, cy = p.index / level.width;
+    const int fine_width = moments_[std::size_t(p.level - 1)].width;
+    for (int k = 0; k < 4; ++k) {
+      stack.push_back({p.level - 1, (2 * cy + k / 2) * fine_width + 2 * cx + k % 2});
+    }
+  }
+  return e * intensity_;
+}
+
+glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level,
+                                         const glm::dvec3& d_map) const {
+  const glm::dvec2 uv = environment_uv(d_map);
+  const double x = uv.x * level.width - 0.5, y = uv.y * level.height - 0.5;
+  const double x_floor = std::floor(x), y_floor = std::floor(y);
+  const double fx = x - x_floor, fy = y - y_floor;
+  auto wrap = [&](int xi) { return ((xi % level.width) + level.width) % level.width; };
+  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
+  const int y0 = std::clamp(int(y_floor), 0, level.height - 1);
+  const int y1 = std::clamp(int(y_floor) + 1, 0, level.height - 1);
+  auto texel = [&](int xi, int yi) {
+    return glm::dvec3(level.texels[std::size_t(yi) * std::size_t(level.width) + std::size_t(xi)]);
+  };
+  return (texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx) * (1.0 - fy) +
+         (texel(x0, y1) * (1.0 - fx) + texel(x1, y1) * fx) * fy;
+}
+
+glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) const {
+  const double top = double(radiance_.size() - 1);
+  lod = std::clamp(lod, 0.0, top);
+  const int l0 = std::min(int(lod), int(radiance_.size()) - 1);
+  const double t = lod - l0;
+  const glm::dvec3 a = bilinear(radiance_[std::size_t(l0)], d_map);
+  if (t == 0.0) return a;
+  return a * (1.0 - t) + bilinear(radiance_[std::size_t(l0 + 1)], d_map) * t;
+}
+
+glm::dvec3 EnvironmentLighting::radiance(const glm::dvec3& d_world) const {
+  return bilinear(radiance_[0], to_map(d_world)) * intensity_;
+}
+
+EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
+                                                    const glm::dvec3& v_world,
+                                                    double roughness) const {
+  EnvironmentIntegrals out;
+  out.irradiance = irradiance_without_suns(n_world);
+  const glm::dvec3 n = to_map(n_world);
+  glm::dvec3 v = to_map(v_world);
+  // A view at or below the shading horizon (normal maps, interpolated normals): moved to just
+  // above it, as the BRDF's |n . v| would see it.
+  double mu = glm::dot(n, v);
+  if (mu < kTableMinMu) {
+    v = glm::normalize(v + n * (kTableMinMu - mu));
+    mu = std::max(glm::dot(n, v), kTableMinMu);
+  }
+  const std::array<double, 3> uniform = uniform_environment_integrals(mu, roughness);
+  out.irradiance_schlick = out.irradiance * (uniform[0] / kPi);
+
+  const double alpha = std::max(roughness * roughness, kMinAlpha), alpha2 = alpha * alpha;
+  glm::dvec3 t, b;
+  tangent_frame(n, t, b);
+  static const std::vector<glm::dvec2> azimuths = hammersley_azimuths(kSpecularSamples);
+  glm::dvec3 a_sum(0.0), b_sum(0.0);
+  double a_weight = 0.0, b_weight = 0.0;
+  for (int k = 0; k < kSpecularSamples; ++k) {
+    double cos_h = 0.0;
+    const glm::dvec3 h = ggx_half_vector((k + 0.5) / kSpecularSamples, azimuths[std::size_t(k)],
+                                         alpha2, n, t, b, cos_h);
+    const double v_dot_h = glm::dot(v, h);
+    if (!(v_dot_h > 0.0)) continue;
+    const glm::dvec3 l = h * (2.0 * v_dot_h) - v;
+    const double n_dot_l = glm::dot(n, l);
+    if (!(n_dot_l > 0.0)) continue;
+    // The sample's share of the sphere, 1 / (N pdf(l)), pdf(l) = D (n.h) / (4 v.h), sets the
+    // pyramid level: half of log2 of its ratio to a texel's, plus one (Krivanek and Colbert).
+    const double k_d = cos_h * cos_h * (alpha2 - 1.0) + 1.0;
+    const double pdf = alpha2 / (kPi * k_d * k_d) * cos_h / (4.0 * v_dot_h);
+    const double lod = 0.5 * std::log2(1.0 / (kSpecularSamples * pdf * texel_solid_angle_)) + 1.0;
+    const glm::dvec3 radiance = lookup(l, lod);
+    const double w = smith_visibility(n_dot_l, mu, alpha2) * n_dot_l * 4.0 * v_dot_h / cos_h;
+    const double s = schlick5(v_dot_h);
+    a_sum += radiance * w;
+    a_weight += w;
+    b_sum += radiance * (w * s);
+    b_weight += w * s;
+  }
+  // The ratio estimator: exact when L is uniform.
+  const glm::dvec3 mirror = lookup(n * (2.0 * mu) - v, 0.0);
+  out.specular = (a_weight > 0.0 ? a_sum / a_weight : mirror) * (uniform[1] * intensity_);
+  out.specular_schlick = (b_weight > 0.0 ? b_sum / b_weight : mirror) * (uniform[2] * intensity_);
+  return out;
+}
+
+}  // namespace covrast::detail

@@ -1,0 +1,106 @@
+// Image-based lighting (docs/environments.md): an environment map prepared once per frame so
+// that shade_point can integrate the glTF BRDF against it at every shading point.
+//
+// Outgoing radiance from the environment at a point with unit normal n and view v:
+//   L_o = integral over the sphere of f(l, v) L(l) max(0, n . l) dl
+// with f the glTF BRDF (Specification Appendix B.3.5, core/shading.cpp pbr_brdf):
+//   f = (1 - F) c_diff / pi + F D V,   F = f0 + (1 - f0) s,   s = (1 - |v . h|)^5,
+// which splits into four integrals that do not depend on the base colour:
+//   E   = int L (n.l)+           (irradiance)         E_s = int s L (n.l)+ / pi
+//   A   = int D V L (n.l)+                            B   = int s D V L (n.l)+
+//   L_o = c_diff (1 - f0) (E / pi - E_s) + f0 A + (1 - f0) B.
+// E is exact up to the texels cut by the horizon: the map is grouped into a pyramid of cells
+// that keep the first moment m = sum_t L_t d_t Omega_t of their texels, and for a cell wholly
+// above the horizon int_cell L (n.l) dl = n . m exactly (n . l is linear in l); cells the
+// horizon cuts are refined down to the finest cells, which take max(0, n . m).
+// A and B are estimated with a fixed set of 64 GGX-distributed directions (Hammersley) read
+// from a radiance pyramid at the level matching each direction's solid angle (filtered
+// importance sampling: Krivanek and Colbert, "Real-time shading with filtered importance
+// sampling", EGSR 2008) as ratio estimators: the weighted mean of the radiance times the
+// uniform-light value of the integral (tables computed once by dense quadrature). E_s is E
+// times its uniform-light ratio (the Schlick weight s varies slowly but at grazing angles).
+// So a uniform environment is integrated exactly (the white furnace), and the error elsewhere
+// is that of the filtered lookups and of E_s's ratio; docs/environments.md gives it as
+// measured against brute-force quadrature.
+#pragma once
+
+#include <covrast/environment.hpp>
+
+#include <glm/glm.hpp>
+
+#include <array>
+#include <vector>
+
+namespace covrast::detail {
+
+/// The parts of L_o that depend on the environment, for one (n, v, roughness).
+struct EnvironmentIntegrals {
+  glm::dvec3 irradiance{0.0};          ///< E = int L (n.l)+ dl
+  glm::dvec3 irradiance_schlick{0.0};  ///< E_s = int s L (n.l)+ dl / pi
+  glm::dvec3 specular{0.0};            ///< A = int D V L (n.l)+ dl
+  glm::dvec3 specular_schlick{0.0};    ///< B = int s D V L (n.l)+ dl
+};
+
+/// A texel bright enough to be lit as a directional light (sun-like): direction and
+/// illuminance L Omega, in the world frame.
+struct EnvironmentSun {
+  glm::dvec3 to_light;
+  glm::dvec3 irradiance;
+};
+
+class EnvironmentLighting {
+ public:
+  /// Prepares `light` (its map must be non-empty): the moment pyramid and the radiance
+  /// pyramid, in the map's frame; intensity and rotation are applied at evaluation.
+  explicit EnvironmentLighting(const EnvironmentLight& light);
+
+  /// E(n) = int L(l) max(0, n . l) dl for a unit world-space normal.
+  glm::dvec3 irradiance(const glm::dvec3& n_world) const;
+
+  /// All four integrals, without the suns, for unit world-space n and v (n . v may be <= 0: then
+  /// only E counts) and perceptual roughness in [0, 1].
+  EnvironmentIntegrals integrals(const glm::dvec3& n_world, const glm::dvec3& v_world,
+                                 double roughness) const;
+
+  /// The radiance arriving from world direction d, bilinear at the finest level (skybox).
+  glm::dvec3 radiance(const glm::dvec3& d_world) const;
+
+  /// The texels taken out of the map as directional lights (integrals() leaves them out;
+  /// irradiance() includes them): each holds at least kSunPowerShare of the map's power.
+  const std::vector<EnvironmentSun>& suns() const { return suns_; }
+
+ private:
+  struct MomentCell {
+    glm::dvec3 centre;            ///< unit direction of the cell's uv centre
+    double sin_radius;            ///< sin of the cell's angular radius around `centre`
+    std::array<glm::dvec3, 3> m;  ///< per channel: sum_t L_t[c] d_t Omega_t
+  };
+  struct MomentLevel {
+    int width = 0, height = 0;
+    std::vector<MomentCell> cells;
+  };
+  struct RadianceLevel {
+    int width = 0, height = 0;
+    std::vector<glm::vec3> texels;
+  };
+
+  glm::dvec3 to_map(const glm::dvec3& d) const;
+  glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
+  glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
+  glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec3& d_map) const;
+
+  std::vector<EnvironmentSun> suns_;
+  std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
+  std::vector<RadianceLevel> radiance_;
+  double texel_solid_angle_ = 0.0;  ///< 4 pi / (W H) of level 0
+  double cos_rotation_ = 1.0, sin_rotation_ = 0.0;
+  double intensity_ = 1.0;
+};
+
+/// Uniform-light values (L = 1) of E_s, A and B for n . v = mu and perceptual roughness r:
+/// {int s (n.l)+ dl / pi, int D V (n.l)+ dl, int s D V (n.l)+ dl}.
+/// From tables computed once per process by dense quadrature, interpolated bilinearly.
+/// Exposed for the tests.
+std::array<double, 3> uniform_environment_integrals(double mu, double roughness);
+
+}  // namespace covrast::detail
