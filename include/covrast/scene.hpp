@@ -257,8 +257,8 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 
 /// A lit scene of one mesh file without a scene file (`covrast render model.glb`): the file's
 /// first camera that a node places, else a camera framing the model from +z (fovy 40 degrees);
-/// the file's KHR_lights_punctual lights, else a default rig of a key, a fill and an ambient
-/// light; the file's materials (OBJ without materials: lambert). docs/scene-format.md,
+/// the file's KHR_lights_punctual lights, else the built-in studio environment
+/// (studio_environment()); the file's materials (OBJ without materials: lambert). docs/scene-format.md,
 /// "Rendering a mesh file without a scene", has the numbers. Throws InputError as load_scene.
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360);
 

@@ -15,9 +15,11 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kMinAlpha = 1e-3;
 /// Finest moment cells: at most this many across (and half as many down). Cells the horizon
 /// cuts take max(0, n . m); their error is at most Omega_cell sin(radius) each.
-constexpr int kMomentCellsAcross = 128;
+constexpr int kMomentCellsAcross = 64;
 /// GGX directions per shading point for A and B.
-constexpr int kSpecularSamples = 64;
+constexpr int kSpecularSamples = 256;
+/// Added to the filtered-importance-sampling level (Krivanek and Colbert add 1).
+constexpr double kLodBias = 0.0;
 /// Uniform-light tables: n . v in [0, 1] and perceptual roughness in [0, 1], both at
 /// evenly spaced nodes; each entry from kTableSamples stratified directions.
 constexpr int kTableMuNodes = 64;
@@ -382,9 +384,7 @@ glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_worl
   return e * intensity_;
 }
 
-glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level,
-                                         const glm::dvec3& d_map) const {
-  const glm::dvec2 uv = environment_uv(d_map);
+glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level, const glm::dvec2& uv) const {
   const double x = uv.x * level.width - 0.5, y = uv.y * level.height - 0.5;
   const double x_floor = std::floor(x), y_floor = std::floor(y);
   const double fx = x - x_floor, fy = y - y_floor;
@@ -404,13 +404,14 @@ glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) cons
   lod = std::clamp(lod, 0.0, top);
   const int l0 = std::min(int(lod), int(radiance_.size()) - 1);
   const double t = lod - l0;
-  const glm::dvec3 a = bilinear(radiance_[std::size_t(l0)], d_map);
+  const glm::dvec2 uv = environment_uv(d_map);
+  const glm::dvec3 a = bilinear(radiance_[std::size_t(l0)], uv);
   if (t == 0.0) return a;
-  return a * (1.0 - t) + bilinear(radiance_[std::size_t(l0 + 1)], d_map) * t;
+  return a * (1.0 - t) + bilinear(radiance_[std::size_t(l0 + 1)], uv) * t;
 }
 
 glm::dvec3 EnvironmentLighting::radiance(const glm::dvec3& d_world) const {
-  return bilinear(radiance_[0], to_map(d_world)) * intensity_;
+  return bilinear(radiance_[0], environment_uv(to_map(d_world))) * intensity_;
 }
 
 EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
@@ -449,7 +450,8 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
     // pyramid level: half of log2 of its ratio to a texel's, plus one (Krivanek and Colbert).
     const double k_d = cos_h * cos_h * (alpha2 - 1.0) + 1.0;
     const double pdf = alpha2 / (kPi * k_d * k_d) * cos_h / (4.0 * v_dot_h);
-    const double lod = 0.5 * std::log2(1.0 / (kSpecularSamples * pdf * texel_solid_angle_)) + 1.0;
+    const double lod =
+        0.5 * std::log2(1.0 / (kSpecularSamples * pdf * texel_solid_angle_)) + kLodBias;
     const glm::dvec3 radiance = lookup(l, lod);
     const double w = smith_visibility(n_dot_l, mu, alpha2) * n_dot_l * 4.0 * v_dot_h / cos_h;
     const double s = schlick5(v_dot_h);

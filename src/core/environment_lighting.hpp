@@ -13,7 +13,7 @@
 // that keep the first moment m = sum_t L_t d_t Omega_t of their texels, and for a cell wholly
 // above the horizon int_cell L (n.l) dl = n . m exactly (n . l is linear in l); cells the
 // horizon cuts are refined down to the finest cells, which take max(0, n . m).
-// A and B are estimated with a fixed set of 64 GGX-distributed directions (Hammersley) read
+// A and B are estimated with a fixed set of 256 GGX-distributed directions (Hammersley) read
 // from a radiance pyramid at the level matching each direction's solid angle (filtered
 // importance sampling: Krivanek and Colbert, "Real-time shading with filtered importance
 // sampling", EGSR 2008) as ratio estimators: the weighted mean of the radiance times the
@@ -87,7 +87,7 @@ class EnvironmentLighting {
   glm::dvec3 to_map(const glm::dvec3& d) const;
   glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
   glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
-  glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec3& d_map) const;
+  glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec2& uv) const;
 
   std::vector<EnvironmentSun> suns_;
   std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
