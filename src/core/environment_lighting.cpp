@@ -16,6 +16,9 @@ constexpr double kMinAlpha = 1e-3;
 /// Finest moment cells: at most this many across (and half as many down). Cells the horizon
 /// cuts take max(0, n . m); their error is at most Omega_cell sin(radius) each.
 constexpr int kMomentCellsAcross = 64;
+/// The irradiance nodes: E at the centres of a 128 x 64 equirectangular grid of normals.
+constexpr int kIrradianceNodesAcross = 128;
+constexpr int kIrradianceNodesDown = 64;
 /// GGX directions per shading point for A and B.
 constexpr int kSpecularSamples = 256;
 /// Added to the filtered-importance-sampling level (Krivanek and Colbert add 1).
@@ -325,6 +328,15 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
     }
     moments_.push_back(std::move(coarse));
   }
+  // The irradiance of the map without its suns at the nodes, by the exact walk; smooth (a
+  // cosine-weighted integral of a map without bright points), so interpolated between them.
+  irradiance_nodes_.reserve(std::size_t(kIrradianceNodesAcross) * kIrradianceNodesDown);
+  for (int y = 0; y < kIrradianceNodesDown; ++y) {
+    for (int x = 0; x < kIrradianceNodesAcross; ++x) {
+      irradiance_nodes_.push_back(walk_irradiance(environment_direction(
+          (x + 0.5) / kIrradianceNodesAcross, (y + 0.5) / kIrradianceNodesDown)));
+    }
+  }
   // The suns in the world frame: R_y(r) d, and x intensity.
   for (EnvironmentSun& sun : suns_) {
     const glm::dvec3 d = sun.to_light;
@@ -349,7 +361,25 @@ glm::dvec3 EnvironmentLighting::irradiance(const glm::dvec3& n_world) const {
 }
 
 glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_world) const {
-  const glm::dvec3 n = to_map(n_world);
+  const glm::dvec2 uv = environment_uv(to_map(n_world));
+  const double x = uv.x * kIrradianceNodesAcross - 0.5, y = uv.y * kIrradianceNodesDown - 0.5;
+  const double x_floor = std::floor(x), y_floor = std::floor(y);
+  const double fx = x - x_floor, fy = y - y_floor;
+  auto wrap = [](int xi) {
+    return ((xi % kIrradianceNodesAcross) + kIrradianceNodesAcross) % kIrradianceNodesAcross;
+  };
+  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
+  const int y0 = std::clamp(int(y_floor), 0, kIrradianceNodesDown - 1);
+  const int y1 = std::clamp(int(y_floor) + 1, 0, kIrradianceNodesDown - 1);
+  auto node = [&](int xi, int yi) {
+    return irradiance_nodes_[std::size_t(yi) * kIrradianceNodesAcross + std::size_t(xi)];
+  };
+  return ((node(x0, y0) * (1.0 - fx) + node(x1, y0) * fx) * (1.0 - fy) +
+          (node(x0, y1) * (1.0 - fx) + node(x1, y1) * fx) * fy) *
+         intensity_;
+}
+
+glm::dvec3 EnvironmentLighting::walk_irradiance(const glm::dvec3& n) const {
   glm::dvec3 e(0.0);
   // Depth-first over the cells the horizon cuts; (level, index) pairs.
   struct Pending {
@@ -381,7 +411,7 @@ glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_worl
       stack.push_back({p.level - 1, (2 * cy + k / 2) * fine_width + 2 * cx + k % 2});
     }
   }
-  return e * intensity_;
+  return e;
 }
 
 glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level, const glm::dvec2& uv) const {

@@ -12,7 +12,9 @@
 // E is exact up to the texels cut by the horizon: the map is grouped into a pyramid of cells
 // that keep the first moment m = sum_t L_t d_t Omega_t of their texels, and for a cell wholly
 // above the horizon int_cell L (n.l) dl = n . m exactly (n . l is linear in l); cells the
-// horizon cuts are refined down to the finest cells, which take max(0, n . m).
+// horizon cuts are refined down to the finest cells, which take max(0, n . m). E is computed so
+// at the nodes of a 128 x 64 grid of normals and interpolated bilinearly between them (the
+// map without its suns is smooth after the cosine convolution).
 // A and B are estimated with a fixed set of 256 GGX-distributed directions (Hammersley) read
 // from a radiance pyramid at the level matching each direction's solid angle (filtered
 // importance sampling: Krivanek and Colbert, "Real-time shading with filtered importance
@@ -86,13 +88,16 @@ class EnvironmentLighting {
 
   glm::dvec3 to_map(const glm::dvec3& d) const;
   glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
+  /// E(n) of the map without suns for a unit normal in the map's frame, by the pyramid walk.
+  glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;
   glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
   glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec2& uv) const;
 
   std::vector<EnvironmentSun> suns_;
   std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
   std::vector<RadianceLevel> radiance_;
-  double texel_solid_angle_ = 0.0;  ///< 4 pi / (W H) of level 0
+  std::vector<glm::dvec3> irradiance_nodes_;  ///< walk_irradiance at the node normals
+  double texel_solid_angle_ = 0.0;            ///< 4 pi / (W H) of level 0
   double cos_rotation_ = 1.0, sin_rotation_ = 0.0;
   double intensity_ = 1.0;
 };
