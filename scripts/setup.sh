@@ -14,7 +14,7 @@ set -euo pipefail
 build_packages=(
   cmake ninja-build g++ pkg-config
   libglm-dev libtbb-dev libspng-dev libturbojpeg0-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
-  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev libdraco-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev libdraco-dev libopenexr-dev
 )
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for
 # the scene and report scripts, chromium to load covrast test's HTML report headless.

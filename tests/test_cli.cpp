@@ -6,6 +6,8 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include "core/srgb.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <nlohmann/json.hpp>
@@ -387,6 +389,111 @@ TEST_CASE("cli: info takes a model file as render does", "[cli]") {
   CHECK(r.err.find("bad.obj") != std::string::npos);
   CHECK(r.err.find("JSON") == std::string::npos);
   check_one_error_line(r);
+}
+
+TEST_CASE("cli: viewer options place the camera, the environment and the tone map", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  const std::string scene = (dir / "scene.json").string();
+  // The orbit: target + radius (sin(phi) sin(theta), cos(phi), sin(phi) cos(theta)).
+  const auto eye_of = [&](std::initializer_list<std::string> extra) {
+    std::vector<std::string> args = {"info", scene, "--json"};
+    args.insert(args.end(), extra.begin(), extra.end());
+    const RunResult r = covrast::test::run_cli_in(dir.path(), args);
+    INFO("stderr: " << r.err);
+    REQUIRE(r.exit_code == 0);
+    return nlohmann::json::parse(r.out);
+  };
+  nlohmann::json info = eye_of({"--orbit", "90,90,2", "--target", "1,2,3", "--fov", "30"});
+  const nlohmann::json& camera = info.at("camera");
+  CHECK(camera.at("eye")[0].get<double>() == Approx(3.0));
+  CHECK(camera.at("eye")[1].get<double>() == Approx(2.0));
+  CHECK(camera.at("eye")[2].get<double>() == Approx(3.0).margin(1e-12));
+  CHECK(camera.at("target")[1] == 2.0);
+  CHECK(camera.at("fovy_deg") == 30.0);
+  // Near and far hold the model's bounding sphere (box x in +-0.866, y in [-0.5, 1], z = 0:
+  // centre (0, 0.25, 0), radius |(1.732, 1.5, 0)| / 2) with 1% to spare.
+  const double distance = std::sqrt(9.0 + 1.75 * 1.75 + 9.0);
+  const double radius = 0.5 * std::sqrt(3.0 + 2.25);
+  CHECK(camera.at("near").get<double>() == Approx(0.99 * (distance - radius)).epsilon(1e-6));
+  CHECK(camera.at("far").get<double>() == Approx(1.01 * (distance + radius)).epsilon(1e-6));
+  info = eye_of({"--orbit", "0,0,1"});  // straight down: up is -z
+  CHECK(info.at("camera").at("eye")[1].get<double>() == Approx(1.0));
+  CHECK(info.at("camera").at("up")[2].get<double>() == Approx(-1.0));
+  info = eye_of({"--orbit", "0,90,2"});
+  CHECK(info.at("camera").at("eye")[2].get<double>() == Approx(2.0));
+  CHECK(info.at("tone_map") == "none");
+  CHECK_FALSE(info.contains("environment"));
+
+  info = eye_of({"--environment", "studio", "--environment-rotation", "30", "--tone-map",
+                 "khronos-pbr-neutral", "--exposure", "1.5"});
+  CHECK(info.at("environment").at("width") == 256);
+  CHECK(info.at("environment").at("rotation_deg") == 30.0);
+  CHECK(info.at("tone_map") == "khronos-pbr-neutral");
+  CHECK(info.at("exposure") == 1.5);
+
+  // Bad values: exit 2, one line naming the option; nothing written.
+  for (const std::vector<std::string>& bad :
+       std::vector<std::vector<std::string>>{{"--orbit", "1,2"},
+                                             {"--orbit", "0,90,-1"},
+                                             {"--target", "a,b,c"},
+                                             {"--fov", "180"},
+                                             {"--tone-map", "filmic"},
+                                             {"--exposure", "0"},
+                                             {"--environment", "missing.hdr"}}) {
+    std::vector<std::string> args = {"render", scene, "-o", (dir / "x.png").string()};
+    args.insert(args.end(), bad.begin(), bad.end());
+    const RunResult r = covrast::test::run_cli_in(dir.path(), args);
+    INFO(bad[0] << " " << bad[1]);
+    CHECK(r.exit_code == 2);
+    check_one_error_line(r);
+    CHECK(r.err.find(bad[0] == "--environment" ? "missing.hdr" : bad[0]) != std::string::npos);
+    CHECK_FALSE(fs::exists(dir / "x.png"));
+  }
+}
+
+TEST_CASE("cli: scene keys environment, tone_map and exposure", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);
+  // A 4 x 2 environment PNG beside the scene, named relative to it.
+  covrast::Image env;
+  env.width = 4;
+  env.height = 2;
+  env.rgb.assign(24, 128);
+  covrast::write_png(env, dir / "env.png");
+  const auto with_keys = [&](const std::string& keys) {
+    std::string text = scene_json("tri.obj");
+    text.insert(text.find('{') + 1, keys + ", ");
+    write_text(dir / "keys.json", text);
+    return covrast::test::run_cli_in(dir.path(), {"info", (dir / "keys.json").string(), "--json"});
+  };
+  RunResult r =
+      with_keys(R"("environment": {"file": "env.png", "rotation_deg": 45, "intensity": 2}, )"
+                R"("tone_map": "aces-narkowicz", "exposure": 0.5)");
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  nlohmann::json info = nlohmann::json::parse(r.out);
+  CHECK(info.at("environment").at("width") == 4);
+  CHECK(info.at("environment").at("intensity") == 2.0);
+  CHECK(info.at("environment").at("mean_radiance")[0].get<double>() ==
+        Approx(covrast::detail::srgb_decode(128 / 255.0)).epsilon(1e-6));
+  CHECK(info.at("tone_map") == "aces-narkowicz");
+  CHECK(info.at("exposure") == 0.5);
+  r = with_keys(R"("environment": "studio")");
+  REQUIRE(r.exit_code == 0);
+  CHECK(nlohmann::json::parse(r.out).at("environment").at("width") == 256);
+  for (const std::string& bad :
+       {std::string(R"("environment": "sky")"), std::string(R"("environment": {"file": 3})"),
+        std::string(R"("environment": {"file": "env.png", "builtin": "studio"})"),
+        std::string(R"("environment": {"file": "env.png", "spin": 1})"),
+        std::string(R"("environment": {"file": "nope.hdr"})"),
+        std::string(R"("environment": {"builtin": "studio", "intensity": -1})"),
+        std::string(R"("tone_map": "filmic")"), std::string(R"("exposure": 0)")}) {
+    INFO(bad);
+    r = with_keys(bad);
+    CHECK(r.exit_code == 2);
+    check_one_error_line(r);
+  }
 }
 
 TEST_CASE("cli: compare exit codes follow the thresholds", "[cli]") {

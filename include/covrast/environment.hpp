@@ -14,8 +14,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <filesystem>
 #include <memory>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace covrast {
@@ -23,6 +26,10 @@ namespace covrast {
 /// Largest side of an environment map [texels] (docs/limits.md); larger maps are refused
 /// before any texel is allocated.
 inline constexpr int kMaxEnvironmentSide = 16384;
+/// Most texels of one environment map (32 Mi: 8192 x 4096), checked from the header.
+inline constexpr std::uint64_t kMaxEnvironmentTexels = std::uint64_t(1) << 25;
+/// Largest environment file read [bytes] (1 GiB).
+inline constexpr std::uint64_t kMaxEnvironmentFileBytes = std::uint64_t(1) << 30;
 
 /// An equirectangular environment map: `width` x `height` texels of linear RGB radiance
 /// [W / (sr m^2), relative], row-major, row 0 the top (+Y) row. Finite and >= 0 everywhere
@@ -68,6 +75,21 @@ inline glm::dvec2 environment_uv(const glm::dvec3& d) {
 }  // namespace covrast
 
 namespace covrast {
+
+/// Reads an environment map file, recognised by its first bytes: Radiance .hdr (RGBE, flat or
+/// run-length, "-Y H +X W"), OpenEXR (R, G, B as float; any compression libopenexr reads, DWAB
+/// included; refused when covrast was built without it), 8-bit PNG or JPEG (sRGB, decoded
+/// exactly to linear). Texels that are negative, NaN or infinite become 0 with one warning
+/// appended to `warnings`. Throws InputError("FILE: cannot ... environment: why"), one line,
+/// for files that cannot be read or decoded or are over the limits above.
+EnvironmentMap load_environment(const std::filesystem::path& path,
+                                std::vector<std::string>* warnings = nullptr);
+
+/// load_environment of bytes in memory, `name` naming them in messages (the fuzz target's
+/// entry point).
+EnvironmentMap decode_environment(const std::uint8_t* bytes, std::size_t size,
+                                  const std::string& name,
+                                  std::vector<std::string>* warnings = nullptr);
 
 /// The built-in neutral studio environment (docs/environments.md has its definition): a
 /// 256 x 128 map of a grey room, brighter above than below, with three soft white box lights

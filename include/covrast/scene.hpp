@@ -107,6 +107,15 @@ struct Material {
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
 
+/// Tone mapping of every shaded colour and the background, in linear light (docs/shading.md,
+/// "Tone mapping and exposure"): None is today's output (exposure still scales).
+enum class ToneMap : std::uint8_t { None, KhronosPbrNeutral, AcesHill, AcesNarkowicz };
+
+/// "none", "khronos-pbr-neutral", "aces-hill", "aces-narkowicz"; throws InputError naming the
+/// accepted names for anything else.
+ToneMap parse_tone_map(const std::string& name);
+const char* to_string(ToneMap tone_map);
+
 /// A light in world space (KHR_lights_punctual units: directional lux, point and spot
 /// candela; ambient is a uniform radiance). Colours are linear RGB.
 struct Light {
@@ -220,6 +229,8 @@ struct Scene {
   std::vector<Light> lights;
   /// Image-based lighting (docs/environments.md); lights the lit meshes of a lit scene.
   std::optional<EnvironmentLight> environment;
+  ToneMap tone_map = ToneMap::None;
+  double exposure = 1.0;  ///< multiplies linear radiance before the tone map, finite, > 0
   /// Triangles dropped at load time because a vertex had a NaN or infinite coordinate.
   std::size_t dropped_nonfinite_triangles = 0;
   /// One line each, e.g. "meshes/a.obj: dropped 3 triangles with NaN/Inf coordinates".
@@ -258,8 +269,9 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 /// A lit scene of one mesh file without a scene file (`covrast render model.glb`): the file's
 /// first camera that a node places, else a camera framing the model from +z (fovy 40 degrees);
 /// the file's KHR_lights_punctual lights, else the built-in studio environment
-/// (studio_environment()); the file's materials (OBJ without materials: lambert). docs/scene-format.md,
-/// "Rendering a mesh file without a scene", has the numbers. Throws InputError as load_scene.
+/// (studio_environment()); the file's materials (OBJ without materials: lambert).
+/// docs/scene-format.md, "Rendering a mesh file without a scene", has the numbers. Throws
+/// InputError as load_scene.
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360);
 
 /// Loads one mesh file (.obj, .gltf, .glb) by itself; used by load_scene and tests.

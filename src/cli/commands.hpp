@@ -20,6 +20,18 @@ namespace covrast::cli {
 /// build as COVRAST_VERSION.
 inline constexpr const char* kVersion = COVRAST_VERSION;
 
+/// The viewer options (src/cli/view_options.cpp): empty or unset leaves the scene's value.
+struct ViewArgs {
+  std::string environment;  ///< a file, or "studio"
+  double environment_rotation_deg = 0.0;
+  double environment_intensity = 1.0;
+  std::string orbit;   ///< "THETA,PHI,RADIUS"
+  std::string target;  ///< "X,Y,Z"
+  std::optional<double> fov_deg;
+  std::string tone_map;
+  std::optional<double> exposure;
+};
+
 struct RenderArgs {
   std::string scene;
   std::string output;
@@ -33,11 +45,13 @@ struct RenderArgs {
   bool strict = false;
   bool quiet = false;
   bool no_cull = false;  ///< keep hidden back faces (RenderOptions::cull_hidden_backfaces)
+  ViewArgs view;
 };
 
 struct InfoArgs {
   std::string scene;
   bool json = false;
+  ViewArgs view;
 };
 
 struct CompareArgs {
@@ -88,6 +102,19 @@ int run_render(const RenderArgs& args);
 int run_info(const InfoArgs& args);
 int run_compare(const CompareArgs& args);
 int run_test(TestArgs args);
+
+/// Adds the viewer options to a subcommand.
+void add_view_options(CLI::App* sub, ViewArgs& args);
+/// Applies them to a loaded scene (environment files are read here); throws InputError
+/// naming the option for bad values.
+void apply_view_args(Scene& scene, const ViewArgs& args);
+/// The orbit camera's eye: target + radius (sin(phi) sin(theta), cos(phi), sin(phi)
+/// cos(theta)), angles in degrees.
+glm::dvec3 orbit_eye(const glm::dvec3& target, double theta_deg, double phi_deg, double radius);
+/// Places scene.camera on that orbit, +Y up, with near and far planes that clip nothing of
+/// the scene's bounding sphere.
+void place_orbit_camera(Scene& scene, const glm::dvec3& target, double theta_deg, double phi_deg,
+                        double radius);
 
 /// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
 /// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x

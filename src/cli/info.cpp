@@ -10,6 +10,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -106,6 +107,28 @@ AlphaCounts alpha_counts(const MeshInstance& instance) {
   return counts;
 }
 
+/// The solid-angle-weighted mean radiance of a map (what a uniform environment of equal power
+/// would have).
+glm::dvec3 mean_radiance(const EnvironmentMap& map) {
+  glm::dvec3 sum(0.0);
+  double weight = 0.0;
+  for (int y = 0; y < map.height; ++y) {
+    const double w = std::cos(std::numbers::pi * y / map.height) -
+                     std::cos(std::numbers::pi * (y + 1) / map.height);
+    for (int x = 0; x < map.width; ++x) sum += glm::dvec3(map.texel(x, y)) * w;
+    weight += w * map.width;
+  }
+  return weight > 0.0 ? sum / weight : sum;
+}
+
+nlohmann::ordered_json environment_json(const EnvironmentLight& light) {
+  return {{"width", light.map->width},
+          {"height", light.map->height},
+          {"mean_radiance", vec_json(mean_radiance(*light.map))},
+          {"rotation_deg", light.rotation_deg},
+          {"intensity", light.intensity}};
+}
+
 nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const Bounds& bounds,
                                  std::size_t total_vertices) {
   nlohmann::ordered_json j;
@@ -121,6 +144,11 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
     j["camera"]["projection"] = "orthographic";
     j["camera"]["ymag"] = scene.camera.ymag;
   }
+  if (scene.environment) {
+    j["environment"] = environment_json(*scene.environment);
+  }
+  j["tone_map"] = to_string(scene.tone_map);
+  j["exposure"] = scene.exposure;
   nlohmann::ordered_json meshes = nlohmann::ordered_json::array();
   for (const MeshInstance& instance : scene.meshes) {
     nlohmann::ordered_json m = {{"source", mesh_source(instance)},
@@ -163,7 +191,16 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
             << (c.orthographic ? "orthographic, ymag " + format_number(c.ymag)
                                : "fovy " + format_number(c.fovy_deg) + " deg")
             << ", near " << format_number(c.near) << ", far " << format_number(c.far) << '\n'
-            << "meshes:      " << scene.meshes.size() << '\n';
+            << "tone map:    " << to_string(scene.tone_map) << ", exposure "
+            << format_number(scene.exposure) << '\n';
+  if (scene.environment) {
+    const nlohmann::ordered_json e = environment_json(*scene.environment);
+    std::cout << "environment: " << e["width"] << "x" << e["height"] << ", mean radiance "
+              << vec_text(mean_radiance(*scene.environment->map)) << ", rotation "
+              << format_number(scene.environment->rotation_deg) << " deg, intensity "
+              << format_number(scene.environment->intensity) << '\n';
+  }
+  std::cout << "meshes:      " << scene.meshes.size() << '\n';
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];
     std::cout << "  [" << i << "] " << mesh_source(instance) << ": " << triangle_count(instance)
@@ -209,11 +246,13 @@ CLI::App* add_info_command(CLI::App& app, InfoArgs& args) {
       ->required()
       ->type_name("SCENE.json|MODEL");
   sub->add_flag("--json", args.json, "Print one JSON line instead of text");
+  add_view_options(sub, args.view);
   return sub;
 }
 
 int run_info(const InfoArgs& args) {
-  const Scene scene = load_scene_or_model(args.scene);
+  Scene scene = load_scene_or_model(args.scene);
+  apply_view_args(scene, args.view);
   const Bounds bounds = world_bounds(scene);
   std::size_t total_vertices = 0;
   for (const MeshInstance& instance : scene.meshes) total_vertices += vertex_count(instance);

@@ -137,6 +137,7 @@ CLI::App* add_render_command(CLI::App& app, RenderArgs& args) {
       ->check(CLI::Range(1, kMaxRepeat))
       ->capture_default_str()
       ->type_name("K");
+  add_view_options(sub, args.view);
   sub->add_flag("--strict", args.strict, "Treat scene warnings as errors (exit 2, no output)");
   sub->add_flag("-q,--quiet", args.quiet, "Do not print the 'wrote ...' lines");
   sub->add_flag("--no-cull", args.no_cull,
@@ -163,7 +164,8 @@ int run_render(const RenderArgs& args) {
   check_output_path(args.output, {".png"});
   if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});
 
-  const Scene scene = load_scene_or_model(args.scene, options.width, options.height);
+  Scene scene = load_scene_or_model(args.scene, options.width, options.height);
+  apply_view_args(scene, args.view);
   if (args.strict && !scene.warnings.empty()) {
     // The error line first (main prints the warnings after it).
     const std::size_t count = scene.warnings.size();

@@ -233,7 +233,11 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
                  mu2 * glm::dvec3(r.normal_world[2]);
   const double n_length = glm::length(n);
   n = n_length > 0.0 ? n * (1.0 / n_length) : glm::dvec3(0.0);
-  if (r.textured == nullptr) return glm::vec3(shade_point(*r.surface, base, p, n));
+  const ToneMapping& mapping = r.surface->context->tone_mapping;
+  const auto finish = [&](const glm::dvec3& radiance) {
+    return glm::vec3(mapping.is_identity() ? radiance : tone_map(mapping, radiance));
+  };
+  if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n));
   // Textured: the surface with this point's texels (core/texture_shading.cpp).
   const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n);
   SurfaceShading s = *r.surface;
@@ -241,7 +245,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   s.roughness = sample.roughness;
   s.occlusion = sample.occlusion;
   s.emissive = sample.emissive;
-  return glm::vec3(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal));
+  return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal));
 }
 
 }  // namespace covrast::detail

@@ -5,6 +5,7 @@
 // The formulas are in docs/shading.md; all arithmetic is double, IEEE, no contraction.
 #pragma once
 
+#include "core/tone_map.hpp"
 #include "core/triangle_setup.hpp"
 
 #include <covrast/texture.hpp>
@@ -46,6 +47,8 @@ struct ShadingContext {
   std::vector<PunctualLight> lights;
   /// The scene's environment, prepared (null: none); lights every lit model but Unlit.
   const EnvironmentLighting* environment = nullptr;
+  /// Applied to each lit colour as it leaves shade_lit (core/tone_map.hpp).
+  ToneMapping tone_mapping;
 };
 
 /// A material's non-empty texture slots (pointers into the scene's Material; null: none).

@@ -152,6 +152,8 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       height_px_(height_px),
       cull_hidden_backfaces_(cull_hidden_backfaces),
       eye_(scene.camera.eye) {
+  tone_mapping_ = {ToneMapOperator(int(scene.tone_map)), scene.exposure};
+  context_.tone_mapping = tone_mapping_;
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
   const double aspect = double(width_px) / double(height_px);
@@ -316,6 +318,10 @@ static_assert(int(ShadingModel::Unlit) == int(LitModel::Unlit) &&
               int(ShadingModel::Lambert) == int(LitModel::Lambert) &&
               int(ShadingModel::BlinnPhong) == int(LitModel::BlinnPhong) &&
               int(ShadingModel::Pbr) == int(LitModel::Pbr));
+static_assert(int(ToneMap::None) == int(ToneMapOperator::None) &&
+              int(ToneMap::KhronosPbrNeutral) == int(ToneMapOperator::KhronosPbrNeutral) &&
+              int(ToneMap::AcesHill) == int(ToneMapOperator::AcesHill) &&
+              int(ToneMap::AcesNarkowicz) == int(ToneMapOperator::AcesNarkowicz));
 static_assert(int(AlphaMode::Opaque) == int(TriangleAlpha::Opaque) &&
               int(AlphaMode::Mask) == int(TriangleAlpha::Mask) &&
               int(AlphaMode::Blend) == int(TriangleAlpha::Blend));
@@ -711,6 +717,11 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.convex_surface = sink.convex_surface;
   t.shading = nullptr;
   t.alpha_mode = TriangleAlpha::Opaque;
+  if (lit == nullptr && !tone_mapping_.is_identity()) {
+    // Unlit colours are tone-mapped at the vertices (exact for uniform and per-triangle
+    // colours; lit ones are tone-mapped where shade_lit makes them).
+    for (glm::vec3& c : t.color) c = glm::vec3(tone_map(tone_mapping_, glm::dvec3(c)));
+  }
   if (lit != nullptr) {
     // Computed only now, for triangles that survived every cull (half of a closed mesh's
     // are hidden back faces).

@@ -845,6 +845,63 @@ namespace {
 
 using MeshFiles = std::map<std::pair<std::string, MeshFormat>, CachedMesh>;
 
+constexpr std::pair<ToneMap, const char*> kToneMapNames[] = {
+    {ToneMap::None, "none"},
+    {ToneMap::KhronosPbrNeutral, "khronos-pbr-neutral"},
+    {ToneMap::AcesHill, "aces-hill"},
+    {ToneMap::AcesNarkowicz, "aces-narkowicz"},
+};
+
+/// "environment": "studio" (the built-in one), or an object with "file" (relative to the scene
+/// file) or "builtin": "studio", and optionally "rotation_deg" and "intensity" (finite, >= 0).
+EnvironmentLight scene_environment(const std::string& file, const json& value,
+                                   const std::filesystem::path& base_dir,
+                                   std::vector<std::string>& warnings) {
+  const SceneReader reader(file);
+  const auto builtin = [&](const json& name, const std::string& path) {
+    if (!name.is_string() || name.get<std::string>() != "studio") {
+      fail(file, path, "expected \"studio\" (the one built-in environment), got " + shown(name));
+    }
+    return studio_environment();
+  };
+  EnvironmentLight light;
+  if (value.is_string()) {
+    light.map = builtin(value, "environment");
+    return light;
+  }
+  reader.require_object(value, "environment");
+  for (const auto& [key, item] : value.items()) {
+    if (key != "file" && key != "builtin" && key != "rotation_deg" && key != "intensity") {
+      fail(file, "environment." + key,
+           "unknown key (expected file or builtin, rotation_deg, intensity)");
+    }
+  }
+  const auto file_it = value.find("file"), builtin_it = value.find("builtin");
+  if ((file_it == value.end()) == (builtin_it == value.end())) {
+    fail(file, "environment", "expected exactly one of \"file\" and \"builtin\"");
+  }
+  if (builtin_it != value.end()) {
+    light.map = builtin(*builtin_it, "environment.builtin");
+  } else {
+    if (!file_it->is_string()) {
+      fail(file, "environment.file", "expected a path string, got " + shown(*file_it));
+    }
+    const std::filesystem::path path =
+        base_dir / std::filesystem::path(file_it->get<std::string>());
+    light.map = std::make_shared<const EnvironmentMap>(load_environment(path, &warnings));
+  }
+  if (const auto it = value.find("rotation_deg"); it != value.end()) {
+    light.rotation_deg = reader.number(*it, "environment.rotation_deg");
+  }
+  if (const auto it = value.find("intensity"); it != value.end()) {
+    light.intensity = reader.number(*it, "environment.intensity");
+    if (light.intensity < 0.0) {
+      fail(file, "environment.intensity", "expected a number >= 0, got " + shown(*it));
+    }
+  }
+  return light;
+}
+
 /// load_scene's work on a parsed root: `file` names it in messages, mesh paths are relative to
 /// `base_dir`, meshes come from and go to `files`. `cameras`, if given, receives the first glTF
 /// entry's cameras (load_mesh_scene looks for one there).
@@ -866,6 +923,22 @@ Scene scene_from_root(const json& root, const std::string& file,
   if (const auto it = root.find("lights"); it != root.end()) {
     scene.lit = true;
     scene.lights = reader.lights(*it, gltf_lights_at);
+  }
+  if (const auto it = root.find("tone_map"); it != root.end()) {
+    if (!it->is_string()) fail(file, "tone_map", "expected a name string, got " + shown(*it));
+    try {
+      scene.tone_map = parse_tone_map(it->get<std::string>());
+    } catch (const InputError& e) {
+      fail(file, "tone_map", e.what());
+    }
+  }
+  if (const auto it = root.find("exposure"); it != root.end()) {
+    scene.exposure = reader.number(*it, "exposure");
+    if (!(scene.exposure > 0.0)) fail(file, "exposure", "expected a number > 0, got " + shown(*it));
+  }
+  if (const auto it = root.find("environment"); it != root.end()) {
+    scene.lit = true;
+    scene.environment = scene_environment(file, *it, base_dir, scene.warnings);
   }
 
   const json& meshes = reader.required(root, "meshes", "meshes");
@@ -955,6 +1028,22 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
   scene.source = mesh_path;
   warn_beyond_finite_range(scene);
   return scene;
+}
+
+ToneMap parse_tone_map(const std::string& name) {
+  std::string names;
+  for (const auto& [tone_map, known] : kToneMapNames) {
+    if (name == known) return tone_map;
+    names += std::string(names.empty() ? "" : ", ") + known;
+  }
+  throw InputError("unknown tone map '" + name + "' (expected " + names + ")");
+}
+
+const char* to_string(ToneMap tone_map) {
+  for (const auto& [known, name] : kToneMapNames) {
+    if (known == tone_map) return name;
+  }
+  return "none";
 }
 
 }  // namespace covrast
