@@ -496,6 +496,67 @@ TEST_CASE("cli: scene keys environment, tone_map and exposure", "[cli]") {
   }
 }
 
+TEST_CASE("cli: scenario renders the render-fidelity harness's JSON", "[cli]") {
+  TempDir dir;
+  write_good_scene(dir);  // tri.obj
+  const std::string out = (dir / "s.png").string();
+  const std::string scenario =
+      R"({"scenario": {"name": "tri", "model": "tri.obj", "dimensions": {"width": 20, "height": 12},
+          "orbit": {"theta": 0, "phi": 90, "radius": 4}, "target": {"x": 0, "y": 0.25, "z": 0},
+          "verticalFoV": 40, "renderSkybox": false, "exclude": ["x"]}, "outputFile": ")" +
+      out + R"("})";
+  RunResult r = covrast::test::run_cli_in(dir.path(), {"scenario", scenario, "--quiet"}, true);
+  INFO("stderr: " << r.err);
+  REQUIRE(r.exit_code == 0);
+  const covrast::Image image = covrast::read_png(out);
+  // Twice the dimensions (the harness's device pixel ratio), white where nothing is drawn.
+  REQUIRE(image.width == 40);
+  REQUIRE(image.height == 24);
+  for (int c = 0; c < 3; ++c) CHECK(image.pixel(0, 0)[c] == 255);
+  // The same camera, light and tone map through `covrast render` shade the middle alike.
+  const std::string rendered = (dir / "r.png").string();
+  r = covrast::test::run_cli_in(
+      dir.path(),
+      {"render", "tri.obj", "-o", rendered, "--size", "40x24", "--orbit", "0,90,4", "--target",
+       "0,0.25,0", "--fov", "40", "--environment", "studio", "--tone-map", "khronos-pbr-neutral"},
+      true);
+  REQUIRE(r.exit_code == 0);
+  const covrast::Image same = covrast::read_png(rendered);
+  for (int c = 0; c < 3; ++c) CHECK(same.pixel(20, 12)[c] == image.pixel(20, 12)[c]);
+  CHECK(image.pixel(20, 12)[0] != 255);
+  // A file holding the JSON works as well.
+  write_text(dir / "scenario.json", scenario);
+  fs::remove(out);
+  r = covrast::test::run_cli_in(dir.path(), {"scenario", "scenario.json", "--quiet"}, true);
+  CHECK(r.exit_code == 0);
+  CHECK(fs::exists(out));
+  // renderSkybox is not drawn: a warning, an error with --strict.
+  std::string skybox = scenario;
+  const std::string no_skybox = "\"renderSkybox\": false";
+  skybox.replace(skybox.find(no_skybox), no_skybox.size(), "\"renderSkybox\": true");
+  r = covrast::test::run_cli_in(dir.path(), {"scenario", skybox, "--quiet", "--strict"}, true);
+  CHECK(r.exit_code == 2);
+  CHECK(r.err.find("renderSkybox") != std::string::npos);
+  // Bad input: exit 2, one line.
+  for (
+      const std::string& bad :
+      {std::string(R"({"scenario": {"model": "tri.obj"}})"),
+       std::string(R"({"scenario": {"model": "gone.glb"}, "outputFile": "o.png"})"),
+       std::string(
+           R"({"scenario": {"model": "tri.obj", "lighting": "gone.hdr"}, "outputFile": "o.png"})"),
+       std::string(
+           R"({"scenario": {"model": "tri.obj", "dimensions": {"width": 0}}, "outputFile": "o.png"})"),
+       std::string(
+           R"({"scenario": {"model": "tri.obj", "orbit": {"radius": "far"}}, "outputFile": "o.png"})"),
+       std::string(R"({"scenario": )"), std::string("missing.json")}) {
+    INFO(bad);
+    r = covrast::test::run_cli_in(dir.path(), {"scenario", bad}, true);
+    CHECK(r.exit_code == 2);
+    check_one_error_line(r);
+    CHECK_FALSE(fs::exists(dir / "o.png"));
+  }
+}
+
 TEST_CASE("cli: compare exit codes follow the thresholds", "[cli]") {
   TempDir dir;
   const covrast::Image a = test_image(9, 7, 1);

@@ -150,12 +150,12 @@ TEST_CASE("tone map: frames", "[tonemap]") {
   covrast::Scene none = plain;
   none.tone_map = covrast::ToneMap::None;
   CHECK(render(none).rgb == render(plain).rgb);
-  // Exposure scales unlit colours and the background.
+  // Exposure scales unlit colours, not the background (a display colour, as a clear colour).
   covrast::Scene doubled = plain;
   doubled.exposure = 2.0;
   const covrast::Image image = render(doubled);
   CHECK(int(image.pixel(16, 16)[0]) == code(0.6f));
-  CHECK(int(image.pixel(0, 0)[2]) == code(double(0.4f) * 2.0));
+  CHECK(int(image.pixel(0, 0)[2]) == code(0.4f));
   // A lit square at 3x the light clips without a tone map and not with khronos-pbr-neutral:
   // its pixel is the operator of the lambert radiance 3 x base.
   covrast::Scene bright = square_scene(glm::vec3(0.8f, 0.5f, 0.3f), true, 3.0);
@@ -167,7 +167,5 @@ TEST_CASE("tone map: frames", "[tonemap]") {
     CHECK(std::abs(int(mapped.pixel(16, 16)[c]) - code(want[c])) <= 1);
     CHECK(int(mapped.pixel(16, 16)[c]) < 255);
   }
-  // The background goes through the operator too.
-  const glm::dvec3 bg = neutral_reference(glm::dvec3(glm::vec3(0.2f, 0.3f, 0.4f)));
-  CHECK(int(mapped.pixel(0, 0)[1]) == code(bg.g));
+  CHECK(int(mapped.pixel(0, 0)[1]) == code(0.3f));
 }

@@ -107,7 +107,7 @@ struct Material {
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
 
-/// Tone mapping of every shaded colour and the background, in linear light (docs/shading.md,
+/// Tone mapping of every shaded colour (not the background colour), in linear light (docs/shading.md,
 /// "Tone mapping and exposure"): None is today's output (exposure still scales).
 enum class ToneMap : std::uint8_t { None, KhronosPbrNeutral, AcesHill, AcesNarkowicz };
 

@@ -48,6 +48,15 @@ struct RenderArgs {
   ViewArgs view;
 };
 
+struct ScenarioArgs {
+  std::string scenario;  ///< the harness's JSON, or a file holding it
+  std::string mode = "coverage";
+  int threads = 0;
+  std::string tone_map = "khronos-pbr-neutral";
+  bool strict = false;
+  bool quiet = false;
+};
+
 struct InfoArgs {
   std::string scene;
   bool json = false;
@@ -100,6 +109,8 @@ CLI::App* add_test_command(CLI::App& app, TestArgs& args);
 /// Each returns the process exit code; InputError and other exceptions propagate to main.
 int run_render(const RenderArgs& args);
 int run_info(const InfoArgs& args);
+CLI::App* add_scenario_command(CLI::App& app, ScenarioArgs& args);
+int run_scenario(const ScenarioArgs& args);
 int run_compare(const CompareArgs& args);
 int run_test(TestArgs args);
 

@@ -49,10 +49,12 @@ int main(int argc, char** argv) {
   covrast::cli::InfoArgs info_args;
   covrast::cli::CompareArgs compare_args;
   covrast::cli::TestArgs test_args;
+  covrast::cli::ScenarioArgs scenario_args;
   CLI::App* render = covrast::cli::add_render_command(app, render_args);
   CLI::App* info = covrast::cli::add_info_command(app, info_args);
   CLI::App* compare = covrast::cli::add_compare_command(app, compare_args);
   CLI::App* test = covrast::cli::add_test_command(app, test_args);
+  CLI::App* scenario = covrast::cli::add_scenario_command(app, scenario_args);
 
   try {
     app.parse(argc, argv);
@@ -75,6 +77,7 @@ int main(int argc, char** argv) {
     if (info->parsed()) return covrast::cli::run_info(info_args);
     if (compare->parsed()) return covrast::cli::run_compare(compare_args);
     if (test->parsed()) return covrast::cli::run_test(test_args);
+    if (scenario->parsed()) return covrast::cli::run_scenario(scenario_args);
     print_error("no subcommand given (run 'covrast --help' for usage)");
     return 2;
   } catch (const covrast::cli::StrictWarningsError& e) {

@@ -1,6 +1,7 @@
 // Tone mapping (docs/shading.md, "Tone mapping and exposure"): linear radiance to linear
 // display values in [0, 1], applied to every shaded colour before it is composited, as the
-// glTF viewers apply it in their fragment shaders. Double precision, no contraction.
+// glTF viewers apply it in their fragment shaders. The background colour is a display colour
+// (the viewers' clear colour) and is not tone-mapped. Double precision, no contraction.
 //
 //   none:                 x -> exposure x (today's bytes at exposure 1; the encode clamps)
 //   khronos-pbr-neutral:  the Khronos PBR Neutral operator (KhronosGroup/ToneMapping,

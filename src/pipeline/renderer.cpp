@@ -11,7 +11,6 @@
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
 #include "core/tile_raster.hpp"
-#include "core/tone_map.hpp"
 #include "fork_join.hpp"
 #include "geometry/frontend.hpp"
 #include "post/fxaa.hpp"
@@ -309,15 +308,9 @@ Renderer::~Renderer() = default;
 RenderResult Renderer::render_frame() {
   Impl& im = *impl_;
   RenderResult result = im.blank_result();
-  // The background is tone-mapped like every shaded colour (core/tone_map.hpp).
-  const detail::ToneMapping mapping{detail::ToneMapOperator(int(im.scene.tone_map)),
-                                    im.scene.exposure};
-  const glm::vec3 background =
-      mapping.is_identity()
-          ? im.scene.background_linear
-          : glm::vec3(detail::tone_map(mapping, glm::dvec3(im.scene.background_linear)));
+  // The background is a display colour (a clear colour), not tone-mapped (docs/shading.md).
   const detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
-                                   background};
+                                   im.scene.background_linear};
   const std::uint64_t overflows_before = im.begin_frame_counters();
   Clock::time_point t0, t1, t2, t3, t4;
   detail::fork_join_execute(im.arena, [&] {
