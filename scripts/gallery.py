@@ -8,15 +8,16 @@ does not load. The screenshots are linked where they are, not copied: their lice
 per model (each folder's LICENSE.md).
 
 Each model is framed by its bounding box like benchmarks/report.py does (camera on +z looking
-at the box centre, the bounding sphere filling the vertical field of view) and lit by the
-rig below (KHR_lights_punctual units; the file's materials, pbr unless KHR_materials_unlit):
-
-    key   directional, travelling (0.5, -0.7, -0.6), white, intensity 3
-    fill  directional, travelling (-0.6, -0.2, -0.5), (0.8, 0.85, 1), intensity 1
-    ambient (1, 1, 1), intensity 0.25
+at the box centre, the bounding sphere filling the vertical field of view), with the file's
+materials, lit as the glTF viewers light a model: by an environment (docs/environments.md),
+tone-mapped with khronos-pbr-neutral. docs/gallery.md uses the built-in studio environment
+(what `covrast render model.glb` uses); docs/gallery-environments.md renders each model once
+per environment file of ../shared/environments (when present), beside the screenshot. Each
+image's render time (the whole `covrast render` process, 2 threads) is in the table.
 
 Usage: scripts/gallery.py [--covrast build/release/covrast] [--models ../shared/models/gltf]
-                          [--size 256x192] [--filter REGEX]
+                          [--environments ../shared/environments] [--size 256x192]
+                          [--filter REGEX]
 """
 
 import argparse
@@ -30,12 +31,7 @@ import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
-LIGHT_RIG = [
-    {"type": "directional", "direction": [0.5, -0.7, -0.6], "color": [1, 1, 1], "intensity": 3.0},
-    {"type": "directional", "direction": [-0.6, -0.2, -0.5], "color": [0.8, 0.85, 1.0],
-     "intensity": 1.0},
-    {"type": "ambient", "color": [1, 1, 1], "intensity": 0.25},
-]
+import time
 
 
 def find_model_file(folder):
@@ -73,13 +69,15 @@ def info(covrast, scene_path):
     return json.loads(out.stdout)
 
 
-def framed_scene(covrast, model_file, size, path):
+def framed_scene(covrast, model_file, size, path, environment):
     """Writes the lit, framed scene of one model to path; returns its `info` JSON."""
     scene = {
         "width": size[0], "height": size[1], "background": [0.18, 0.18, 0.2],
         "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40,
                    "near": 0.1, "far": 100},
-        "lights": LIGHT_RIG,
+        "environment": ({"builtin": "studio"} if environment is None
+                        else {"file": os.path.abspath(environment)}),
+        "tone_map": "khronos-pbr-neutral",
         "meshes": [{"gltf": os.path.abspath(model_file)}],
     }
     with open(path, "w") as f:
@@ -100,24 +98,30 @@ def framed_scene(covrast, model_file, size, path):
     return described
 
 
-def render_model(covrast, name, model_file, size, tmp, images_dir):
-    """Renders one model; returns (image path, warnings text) or raises RuntimeError."""
+def render_model(covrast, name, model_file, size, tmp, images_dir, environment=None):
+    """Renders one model; returns (image path, warnings text, seconds) or raises
+    RuntimeError."""
     scene_path = os.path.join(tmp, name + ".json")
-    described = framed_scene(covrast, model_file, size, scene_path)
+    described = framed_scene(covrast, model_file, size, scene_path, environment)
     out_png = os.path.join(images_dir, name + ".png")
-    run = subprocess.run([covrast, "render", scene_path, "-o", out_png, "--quiet"],
-                         capture_output=True, text=True)
+    start = time.monotonic()
+    run = subprocess.run([covrast, "render", scene_path, "-o", out_png, "--quiet", "--threads",
+                          "2"], capture_output=True, text=True)
+    seconds = time.monotonic() - start
     if run.returncode != 0:
         raise RuntimeError(run.stderr.strip().splitlines()[-1])
     # Warnings name the file by its full path: the model's folder says enough.
     folder = os.path.dirname(os.path.dirname(os.path.abspath(model_file))) + os.sep
-    return out_png, "; ".join(w.replace(folder, "") for w in described.get("warnings", []))
+    warnings = "; ".join(w.replace(folder, "") for w in described.get("warnings", []))
+    return out_png, warnings, seconds
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--covrast", default=os.path.join(ROOT, "build/release/covrast"))
     parser.add_argument("--models", default=os.path.join(ROOT, "..", "shared", "models", "gltf"))
+    parser.add_argument("--environments",
+                        default=os.path.join(ROOT, "..", "shared", "environments"))
     parser.add_argument("--size", default="256x192")
     parser.add_argument("--filter", default="")
     opts = parser.parse_args()
@@ -125,6 +129,11 @@ def main():
     if not os.path.isdir(opts.models):
         print(f"gallery: {opts.models} not found, nothing to do")
         return 0
+    environments = []
+    if os.path.isdir(opts.environments):
+        environments = sorted(os.path.join(opts.environments, f)
+                              for f in os.listdir(opts.environments)
+                              if f.lower().endswith((".hdr", ".exr")))
     docs = os.path.join(ROOT, "docs")
     images_dir = os.path.join(docs, "images", "gallery")
     os.makedirs(images_dir, exist_ok=True)
@@ -140,39 +149,80 @@ def main():
                 skipped.append((name, "no glTF/ or glTF-Binary/ variant"))
                 continue
             try:
-                image, warnings = render_model(opts.covrast, safe, model_file, size, tmp,
-                                               images_dir)
+                studio = render_model(opts.covrast, safe, model_file, size, tmp, images_dir)
+                lit = []
+                for env in environments:
+                    env_name = os.path.splitext(os.path.basename(env))[0]
+                    lit.append(render_model(opts.covrast, safe + "-" + env_name, model_file, size,
+                                            tmp, images_dir, env))
             except RuntimeError as e:
                 # Messages name files by their full path: the model's folder says enough.
                 skipped.append((name, str(e).replace(os.path.abspath(folder) + os.sep, "")))
                 continue
             shot = find_screenshot(folder)
-            rows.append((name, os.path.relpath(image, docs),
-                         os.path.relpath(shot, docs) if shot else None, warnings))
-            print(f"gallery: {name}")
-    write_markdown(os.path.join(docs, "gallery.md"), rows, skipped, size)
+            rows.append({"name": name, "studio": studio, "lit": lit,
+                         "shot": os.path.relpath(shot, docs) if shot else None})
+            print(f"gallery: {name} ({studio[2]:.2f} s)")
+    write_studio_page(os.path.join(docs, "gallery.md"), docs, rows, skipped, size)
+    if environments:
+        write_environments_page(os.path.join(docs, "gallery-environments.md"), docs, rows,
+                                environments, size)
     return 0
 
 
-def write_markdown(path, rows, skipped, size):
+def image_cell(docs, name, rendered):
+    image, _, seconds = rendered
+    return f"![{name}]({os.path.relpath(image, docs)})<br>{seconds:.2f} s"
+
+
+def write_studio_page(path, docs, rows, skipped, size):
+    total = sum(row["studio"][2] for row in rows)
     lines = [
         "# Gallery: the glTF sample models, lit",
         "",
         "Written by `scripts/gallery.py` (not part of the test suite). Left: covrast, coverage "
         f"mode, {size[0]}x{size[1]}, the file's materials, textures (docs/textures.md) and "
-        "alpha modes (docs/transparency.md) under the script's light rig. Right: the publisher's screenshot, linked from `../shared/models/gltf` "
-        "(not copied; licences vary per model). Framing, lights and materials differ from the "
-        "publishers' viewers, so compare shapes and shading, not exact colours.",
+        "alpha modes (docs/transparency.md), lit by the built-in studio environment "
+        "(docs/environments.md) and tone-mapped with khronos-pbr-neutral, with the time of the "
+        f"whole `covrast render` process on 2 threads ({total:.1f} s for the {len(rows)} "
+        "models). Right: the publisher's screenshot, linked from `../shared/models/gltf` "
+        "(not copied; licences vary per model). Framing and environments differ from the "
+        "publishers' viewers, so compare shapes and shading, not exact colours. "
+        "[gallery-environments.md](gallery-environments.md) renders the shared HDR "
+        "environments.",
         "",
         "| model | covrast | publisher | warnings |",
         "|---|---|---|---|",
     ]
-    for name, image, shot, warnings in rows:
-        shot_cell = f"![{name} screenshot]({shot})" if shot else "(none)"
-        lines.append(f"| {name} | ![{name}]({image}) | {shot_cell} | {warnings} |")
+    for row in rows:
+        shot_cell = f"![{row['name']} screenshot]({row['shot']})" if row["shot"] else "(none)"
+        lines.append(f"| {row['name']} | {image_cell(docs, row['name'], row['studio'])} | "
+                     f"{shot_cell} | {row['studio'][1]} |")
     if skipped:
         lines += ["", "Skipped:", ""]
         lines += [f"- {name}: {reason}" for name, reason in skipped]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def write_environments_page(path, docs, rows, environments, size):
+    names = [os.path.basename(e) for e in environments]
+    lines = [
+        "# Gallery: the glTF sample models in the shared environments",
+        "",
+        "Written by `scripts/gallery.py` (not part of the test suite): each model lit by each "
+        "equirectangular environment of `../shared/environments` (CC0 HDRs, not copied), "
+        f"coverage mode, {size[0]}x{size[1]}, khronos-pbr-neutral, with the time of the whole "
+        "`covrast render` process (2 threads, the environment file read and prepared each "
+        "time), beside the publisher's screenshot.",
+        "",
+        "| model | " + " | ".join(names) + " | publisher |",
+        "|---|" + "---|" * len(names) + "---|",
+    ]
+    for row in rows:
+        shot_cell = f"![{row['name']} screenshot]({row['shot']})" if row["shot"] else "(none)"
+        cells = " | ".join(image_cell(docs, row["name"], lit) for lit in row["lit"])
+        lines.append(f"| {row['name']} | {cells} | {shot_cell} |")
     with open(path, "w") as f:
         f.write("\n".join(lines) + "\n")
 

@@ -19,7 +19,7 @@
 #include <numbers>
 #include <vector>
 
-#include "test_meshes.hpp"
+#include "test_sphere_scene.hpp"
 
 using covrast::EnvironmentLight;
 using covrast::EnvironmentMap;
@@ -48,24 +48,8 @@ std::shared_ptr<const EnvironmentMap> make_map(
   return map;
 }
 
-/// The unit sphere (exact normals) seen from `eye` towards the origin, 96 x 96, fovy 40.
 Scene sphere_scene(const glm::vec3& base, const Material& material, const glm::dvec3& eye) {
-  Scene scene;
-  scene.width = scene.height = 96;
-  scene.camera.eye = eye;
-  scene.camera.target = {0.0, 0.0, 0.0};
-  scene.camera.fovy_deg = 40.0;
-  scene.camera.near = 0.5;
-  scene.camera.far = 10.0;
-  auto sphere = covrast::test::uv_sphere(96, 192);
-  std::vector<glm::vec3> normals;
-  for (const std::uint32_t i : sphere->indices) normals.push_back(sphere->positions[i]);
-  covrast::analyze_mesh_topology(*sphere);
-  covrast::test::add_instance(scene, sphere, base);
-  scene.meshes[0].materials = {material};
-  scene.meshes[0].corner_normals = std::make_shared<const std::vector<glm::vec3>>(normals);
-  scene.lit = true;
-  return scene;
+  return covrast::test::lit_sphere_scene(base, material, eye);
 }
 
 covrast::Image render_coverage(const Scene& scene) {
@@ -74,35 +58,10 @@ covrast::Image render_coverage(const Scene& scene) {
   return covrast::render(scene, options).color;
 }
 
-/// The largest code difference over the interior pixels (n . v > 0.3) between the image
-/// and the 8-bit code of expected(n, v) (linear) on the exact sphere seen from (0, 0, 3).
 int worst_difference(
     const covrast::Image& image, const Scene& scene,
     const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected, int& checked) {
-  const double t = std::tan(scene.camera.fovy_deg * kPi / 360.0);
-  int worst = 0;
-  checked = 0;
-  for (int y = 0; y < scene.height; ++y) {
-    for (int x = 0; x < scene.width; ++x) {
-      const glm::dvec3 d =
-          glm::normalize(glm::dvec3((2.0 * (x + 0.5) / scene.width - 1.0) * t,
-                                    (1.0 - 2.0 * (y + 0.5) / scene.height) * t, -1.0));
-      const glm::dvec3 o = scene.camera.eye;
-      const double b = glm::dot(o, d), c = glm::dot(o, o) - 1.0;
-      const double disc = b * b - c;
-      if (disc <= 0.0) continue;
-      const glm::dvec3 n = o + (-b - std::sqrt(disc)) * d;
-      if (glm::dot(n, -d) < 0.3) continue;
-      const glm::dvec3 value = expected(n, -d);
-      const std::uint8_t* p = image.pixel(x, y);
-      for (int ch = 0; ch < 3; ++ch) {
-        const int code = covrast::detail::encode_srgb8(float(value[ch]));
-        worst = std::max(worst, std::abs(int(p[ch]) - code));
-      }
-      ++checked;
-    }
-  }
-  return worst;
+  return covrast::test::worst_sphere_difference(image, scene, expected, checked);
 }
 
 /// The directional albedo int f(l, v) (n.l)+ dl of the glTF BRDF at n . v = mu, by the
@@ -192,7 +151,7 @@ TEST_CASE("environment: one bright texel lights as a directional light of its il
   // Texel (100, 20) (up, left and in front of the sphere) of a 128 x 64 map; its radiance times its
   // solid angle is 2.5 lux.
   constexpr int kW = 128, kH = 64, kX = 100, kY = 20;
-  const double omega = 2.0 * kPi / kW * (std::cos(kPi * kY / kH) - std::cos(kPi * (kY + 1) / kH));
+  const double omega = covrast::environment_texel_solid_angle(kY, kW, kH);
   auto map = std::make_shared<EnvironmentMap>();
   map->width = kW;
   map->height = kH;
@@ -291,20 +250,16 @@ glm::dvec3 brute_force_environment(const EnvironmentMap& map, double rotation_de
                                    const glm::dvec3& n, const glm::dvec3& v) {
   const double r = rotation_deg * kPi / 180.0;
   glm::dvec3 sum(0.0);
-  for (int y = 0; y < map.height; ++y) {
-    const double omega = 2.0 * kPi / map.width *
-                         (std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
-    for (int x = 0; x < map.width; ++x) {
-      const glm::dvec3 d =
-          covrast::environment_direction((x + 0.5) / map.width, (y + 0.5) / map.height);
-      const glm::dvec3 l(d.x * std::cos(r) + d.z * std::sin(r), d.y,
-                         -d.x * std::sin(r) + d.z * std::cos(r));
-      const double n_dot_l = glm::dot(n, l);
-      if (!(n_dot_l > 0.0)) continue;
-      sum += covrast::detail::pbr_brdf(base, metallic, roughness, n, v, l) *
-             glm::dvec3(map.texel(x, y)) * (n_dot_l * omega);
-    }
-  }
+  covrast::test::for_each_texel(
+      map, [&](const glm::dvec3& d, double omega, const glm::dvec3& radiance) {
+        const glm::dvec3 l(d.x * std::cos(r) + d.z * std::sin(r), d.y,
+                           -d.x * std::sin(r) + d.z * std::cos(r));
+        const double n_dot_l = glm::dot(n, l);
+        if (n_dot_l > 0.0) {
+          sum += covrast::detail::pbr_brdf(base, metallic, roughness, n, v, l) * radiance *
+                 (n_dot_l * omega);
+        }
+      });
   return sum;
 }
 

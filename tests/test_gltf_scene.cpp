@@ -21,6 +21,7 @@
 
 #include "test_cli_run.hpp"
 #include "test_gltf_files.hpp"
+#include "test_sphere_scene.hpp"
 #include "test_tempdir.hpp"
 
 namespace fs = std::filesystem;
@@ -331,17 +332,11 @@ namespace {
 /// Irradiance of the studio environment on a surface facing n, summed texel by texel:
 /// sum_t L_t max(0, n . d_t) Omega_t (docs/environments.md).
 glm::dvec3 studio_irradiance(const glm::dvec3& n) {
-  const covrast::EnvironmentMap& map = *covrast::studio_environment();
   glm::dvec3 e(0.0);
-  for (int y = 0; y < map.height; ++y) {
-    const double omega = 2.0 * kPi / map.width *
-                         (std::cos(kPi * y / map.height) - std::cos(kPi * (y + 1) / map.height));
-    for (int x = 0; x < map.width; ++x) {
-      const glm::dvec3 d =
-          covrast::environment_direction((x + 0.5) / map.width, (y + 0.5) / map.height);
-      e += glm::dvec3(map.texel(x, y)) * (std::max(0.0, glm::dot(n, d)) * omega);
-    }
-  }
+  covrast::test::for_each_texel(*covrast::studio_environment(),
+                                [&](const glm::dvec3& d, double omega, const glm::dvec3& l) {
+                                  e += l * (std::max(0.0, glm::dot(n, d)) * omega);
+                                });
   return e;
 }
 

@@ -15,7 +15,7 @@
 #include <numbers>
 #include <vector>
 
-#include "test_meshes.hpp"
+#include "test_sphere_scene.hpp"
 
 using covrast::Light;
 using covrast::LightType;
@@ -25,62 +25,22 @@ using covrast::ShadingModel;
 
 namespace {
 
-/// A 96 x 96 scene of the unit sphere (96 x 192 quads, exact normals: the positions) with
-/// base colour `base`, material `material` and `lights`, camera at (0, 0, 3), fovy 40.
+/// The sphere of test_sphere_scene.hpp lit by `lights`, seen from (0, 0, 3).
 Scene sphere_scene(const glm::vec3& base, const Material& material, std::vector<Light> lights) {
-  Scene scene;
-  scene.width = scene.height = 96;
-  scene.camera.eye = {0.0, 0.0, 3.0};
-  scene.camera.target = {0.0, 0.0, 0.0};
-  scene.camera.fovy_deg = 40.0;
-  scene.camera.near = 0.5;
-  scene.camera.far = 10.0;
-  auto sphere = covrast::test::uv_sphere(96, 192);
-  std::vector<glm::vec3> normals;
-  for (const std::uint32_t i : sphere->indices) normals.push_back(sphere->positions[i]);
-  covrast::analyze_mesh_topology(*sphere);
-  covrast::test::add_instance(scene, sphere, base);
-  scene.meshes[0].materials = {material};
-  scene.meshes[0].corner_normals = std::make_shared<const std::vector<glm::vec3>>(normals);
-  scene.lit = true;
+  Scene scene = covrast::test::lit_sphere_scene(base, material);
   scene.lights = std::move(lights);
   return scene;
 }
 
-/// The largest difference, over the interior pixels (the ray meets the sphere with n . -d >
-/// 0.3), between the image and the 8-bit code of `expected(p, n, v)` (linear) at the exact
-/// hit point p (= n) with v = -d; `checked` counts those pixels.
+/// worst_sphere_difference of the scene rendered in `mode` on 2 threads.
 int worst_difference(
     const Scene& scene, const char* mode,
     const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected, int& checked) {
   covrast::RenderOptions options;
   options.mode = covrast::parse_render_mode(mode);
   options.threads = 2;
-  const covrast::Image image = covrast::render(scene, options).color;
-  const double t = std::tan(scene.camera.fovy_deg * std::numbers::pi / 360.0);
-  int worst = 0;
-  checked = 0;
-  for (int y = 0; y < scene.height; ++y) {
-    for (int x = 0; x < scene.width; ++x) {
-      const glm::dvec3 d =
-          glm::normalize(glm::dvec3((2.0 * (x + 0.5) / scene.width - 1.0) * t,
-                                    (1.0 - 2.0 * (y + 0.5) / scene.height) * t, -1.0));
-      const glm::dvec3 o = scene.camera.eye;
-      const double b = glm::dot(o, d), c = glm::dot(o, o) - 1.0;
-      const double disc = b * b - c;
-      if (disc <= 0.0) continue;
-      const glm::dvec3 n = o + (-b - std::sqrt(disc)) * d;
-      if (glm::dot(n, -d) < 0.3) continue;
-      const glm::dvec3 value = expected(n, -d);
-      const std::uint8_t* p = image.pixel(x, y);
-      for (int ch = 0; ch < 3; ++ch) {
-        const int code = covrast::detail::encode_srgb8(float(value[ch]));
-        worst = std::max(worst, std::abs(int(p[ch]) - code));
-      }
-      ++checked;
-    }
-  }
-  return worst;
+  return covrast::test::worst_sphere_difference(covrast::render(scene, options).color, scene,
+                                                expected, checked);
 }
 
 }  // namespace

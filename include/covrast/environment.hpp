@@ -62,6 +62,13 @@ inline glm::dvec3 environment_direction(double u, double v) {
   return {-s * std::cos(theta), std::cos(phi), -s * std::sin(theta)};
 }
 
+/// The solid angle [sr] of texel row y of a W x H map: (2 pi / W) (cos(pi y / H) -
+/// cos(pi (y + 1) / H)), the band between the row's edges split into W texels.
+inline double environment_texel_solid_angle(int y, int width, int height) {
+  return 2.0 * std::numbers::pi / width *
+         (std::cos(std::numbers::pi * y / height) - std::cos(std::numbers::pi * (y + 1) / height));
+}
+
 /// The inverse of environment_direction for a unit direction d: u in [0, 1), v in [0, 1].
 inline glm::dvec2 environment_uv(const glm::dvec3& d) {
   double theta = std::atan2(-d.z, -d.x);  // in (-pi, pi]

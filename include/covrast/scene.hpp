@@ -107,8 +107,8 @@ struct Material {
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
 
-/// Tone mapping of every shaded colour (not the background colour), in linear light (docs/shading.md,
-/// "Tone mapping and exposure"): None is today's output (exposure still scales).
+/// Tone mapping of every shaded colour (not the background colour), in linear light
+/// (docs/shading.md, "Tone mapping and exposure"): None is today's output (exposure still scales).
 enum class ToneMap : std::uint8_t { None, KhronosPbrNeutral, AcesHill, AcesNarkowicz };
 
 /// "none", "khronos-pbr-neutral", "aces-hill", "aces-narkowicz"; throws InputError naming the
@@ -273,6 +273,16 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 /// docs/scene-format.md, "Rendering a mesh file without a scene", has the numbers. Throws
 /// InputError as load_scene.
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360);
+
+/// The orbit camera of the glTF viewers (model-viewer's camera-orbit, the render-fidelity
+/// harness): target + radius (sin(phi) sin(theta), cos(phi), sin(phi) cos(theta)), angles in
+/// degrees (theta = 0, phi = 90 looks from +Z).
+glm::dvec3 orbit_eye(const glm::dvec3& target, double theta_deg, double phi_deg, double radius);
+/// Places scene.camera there, looking at `target`, +Y up (looking straight up or down: the
+/// direction of smaller phi on the orbit), perspective, with near and far planes that clip
+/// nothing of the bounding sphere of the meshes' world box (1% to spare).
+void place_orbit_camera(Scene& scene, const glm::dvec3& target, double theta_deg, double phi_deg,
+                        double radius);
 
 /// Loads one mesh file (.obj, .gltf, .glb) by itself; used by load_scene and tests.
 /// For glTF the node transforms are baked into the positions and COLOR_0 x

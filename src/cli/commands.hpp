@@ -119,13 +119,6 @@ void add_view_options(CLI::App* sub, ViewArgs& args);
 /// Applies them to a loaded scene (environment files are read here); throws InputError
 /// naming the option for bad values.
 void apply_view_args(Scene& scene, const ViewArgs& args);
-/// The orbit camera's eye: target + radius (sin(phi) sin(theta), cos(phi), sin(phi)
-/// cos(theta)), angles in degrees.
-glm::dvec3 orbit_eye(const glm::dvec3& target, double theta_deg, double phi_deg, double radius);
-/// Places scene.camera on that orbit, +Y up, with near and far planes that clip nothing of
-/// the scene's bounding sphere.
-void place_orbit_camera(Scene& scene, const glm::dvec3& target, double theta_deg, double phi_deg,
-                        double radius);
 
 /// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
 /// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x

@@ -10,7 +10,6 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
-#include <numbers>
 #include <set>
 #include <string>
 #include <vector>
@@ -113,10 +112,9 @@ glm::dvec3 mean_radiance(const EnvironmentMap& map) {
   glm::dvec3 sum(0.0);
   double weight = 0.0;
   for (int y = 0; y < map.height; ++y) {
-    const double w = std::cos(std::numbers::pi * y / map.height) -
-                     std::cos(std::numbers::pi * (y + 1) / map.height);
+    const double w = environment_texel_solid_angle(y, map.width, map.height);
     for (int x = 0; x < map.width; ++x) sum += glm::dvec3(map.texel(x, y)) * w;
-    weight += w * map.width;
+    weight += w * map.width;  // 4 pi in all
   }
   return weight > 0.0 ? sum / weight : sum;
 }

@@ -7,10 +7,7 @@
 #include <covrast/error.hpp>
 #include <covrast/scene.hpp>
 
-#include <algorithm>
 #include <cmath>
-#include <limits>
-#include <numbers>
 #include <sstream>
 #include <string>
 
@@ -31,58 +28,7 @@ glm::dvec3 parse_triple(const std::string& text, const char* option) {
   return {v[0], v[1], v[2]};
 }
 
-/// The world box of the scene's meshes (each mesh's box through its model matrix).
-bool world_box(const Scene& scene, glm::dvec3& lo, glm::dvec3& hi) {
-  lo = glm::dvec3(std::numeric_limits<double>::max());
-  hi = glm::dvec3(std::numeric_limits<double>::lowest());
-  for (const MeshInstance& instance : scene.meshes) {
-    if (instance.mesh->triangle_count() == 0) continue;
-    const glm::dvec3 a(instance.mesh->bounds_min), b(instance.mesh->bounds_max);
-    for (int corner = 0; corner < 8; ++corner) {
-      const glm::dvec3 p(instance.model * glm::dvec4(corner & 1 ? b.x : a.x, corner & 2 ? b.y : a.y,
-                                                     corner & 4 ? b.z : a.z, 1.0));
-      lo = glm::min(lo, p);
-      hi = glm::max(hi, p);
-    }
-  }
-  return lo.x <= hi.x;
-}
-
 }  // namespace
-
-glm::dvec3 orbit_eye(const glm::dvec3& target, double theta_deg, double phi_deg, double radius) {
-  const double theta = theta_deg * std::numbers::pi / 180.0;
-  const double phi = phi_deg * std::numbers::pi / 180.0;
-  return target + radius * glm::dvec3(std::sin(phi) * std::sin(theta), std::cos(phi),
-                                      std::sin(phi) * std::cos(theta));
-}
-
-void place_orbit_camera(Scene& scene, const glm::dvec3& target, double theta_deg, double phi_deg,
-                        double radius) {
-  Camera& camera = scene.camera;
-  camera.orthographic = false;
-  camera.target = target;
-  camera.eye = orbit_eye(target, theta_deg, phi_deg, radius);
-  const double phi = phi_deg * std::numbers::pi / 180.0;
-  const double theta = theta_deg * std::numbers::pi / 180.0;
-  // +Y up, except looking straight up or down, where the up is the direction of smaller phi
-  // on the orbit: (-cos(phi) sin(theta), sin(phi), -cos(phi) cos(theta)).
-  camera.up = std::abs(std::sin(phi)) > 1e-9 ? glm::dvec3(0.0, 1.0, 0.0)
-                                             : glm::dvec3(-std::cos(phi) * std::sin(theta), 0.0,
-                                                          -std::cos(phi) * std::cos(theta));
-  // Near and far from the model's bounding sphere around the eye: nothing of it is clipped.
-  glm::dvec3 lo, hi;
-  double reach = radius;
-  double centre_distance = 0.0, sphere = 0.0;
-  if (world_box(scene, lo, hi)) {
-    const glm::dvec3 centre = 0.5 * (lo + hi);
-    sphere = 0.5 * glm::length(hi - lo);
-    centre_distance = glm::length(centre - camera.eye);
-    reach = centre_distance + sphere;
-  }
-  camera.far = std::max(1.01 * reach, 1e-3);
-  camera.near = std::max(0.99 * (centre_distance - sphere), 1e-4 * camera.far);
-}
 
 void apply_view_args(Scene& scene, const ViewArgs& args) {
   if (!args.environment.empty()) {

@@ -174,13 +174,6 @@ const UniformTables& uniform_tables() {
   return tables;
 }
 
-/// The solid angle of texel row y of an equirectangular map H rows high and W wide:
-/// (2 pi / W) (cos(phi0) - cos(phi1)), phi0 = pi y / H, phi1 = pi (y + 1) / H.
-double row_solid_angle(int y, int width, int height) {
-  return 2.0 * kPi / width *
-         (std::cos(kPi * y / double(height)) - std::cos(kPi * (y + 1) / double(height)));
-}
-
 }  // namespace
 
 std::array<double, 3> uniform_environment_integrals(double mu, double roughness) {
@@ -223,7 +216,7 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
     };
     std::vector<Bright> bright;
     for (int y = 0; y < h; ++y) {
-      const double omega = row_solid_angle(y, w, h);
+      const double omega = environment_texel_solid_angle(y, w, h);
       for (int x = 0; x < w; ++x) {
         const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
         const double power = luminance(glm::dvec3(texels[i])) * omega;
@@ -239,7 +232,8 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
       const int x = int(bright[k].index % std::size_t(w)),
                 y = int(bright[k].index / std::size_t(w));
       const glm::dvec3 d = environment_direction((x + 0.5) / w, (y + 0.5) / h);
-      suns_.push_back({d, glm::dvec3(texels[bright[k].index]) * row_solid_angle(y, w, h)});
+      suns_.push_back(
+          {d, glm::dvec3(texels[bright[k].index]) * environment_texel_solid_angle(y, w, h)});
       texels[bright[k].index] = glm::vec3(0.0f);
     }
   }
@@ -256,7 +250,7 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
         glm::dvec3 sum(0.0);
         double weight = 0.0;
         for (int fy = 2 * y; fy < std::min(2 * y + 2, fine.height); ++fy) {
-          const double omega = row_solid_angle(fy, fine.width, fine.height);
+          const double omega = environment_texel_solid_angle(fy, fine.width, fine.height);
           for (int fx = 2 * x; fx < std::min(2 * x + 2, fine.width); ++fx) {
             sum += glm::dvec3(
                        fine.texels[std::size_t(fy) * std::size_t(fine.width) + std::size_t(fx)]) *
@@ -290,7 +284,7 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
   MomentLevel finest{cells_x, cells_y, {}};
   finest.cells.resize(std::size_t(cells_x) * std::size_t(cells_y));
   for (int y = 0; y < h; ++y) {
-    const double omega = row_solid_angle(y, w, h);
+    const double omega = environment_texel_solid_angle(y, w, h);
     const int cy = int(std::int64_t(y) * cells_y / h);
     for (int x = 0; x < w; ++x) {
       const int cx = int(std::int64_t(x) * cells_x / w);

@@ -150,13 +150,13 @@ EnvironmentMap decode_hdr(const std::uint8_t* bytes, std::size_t size, const std
   EnvironmentMap map;
   map.width = int(width);
   map.height = int(height);
-  map.radiance_linear.resize(std::size_t(width) * std::size_t(height));
+  // Row by row: the texels grow with the rows that decode, so a short file claiming a large
+  // map fails before the map is allocated (run-length rows are at least 8 bytes).
   std::vector<std::uint8_t> rgbe(std::size_t(width) * 4);
   for (int y = 0; y < map.height; ++y) {
     read_rgbe_scanline(name, bytes, size, at, map.width, y, rgbe);
     for (int x = 0; x < map.width; ++x) {
-      map.radiance_linear[std::size_t(y) * std::size_t(width) + std::size_t(x)] =
-          rgbe_radiance(&rgbe[std::size_t(x) * 4]);
+      map.radiance_linear.push_back(rgbe_radiance(&rgbe[std::size_t(x) * 4]));
     }
   }
   return map;
