@@ -75,8 +75,10 @@ for cpu in "${cpus[@]}"; do
       render_pair "${scenes[$i]}" "${modes[$i]}" 160x90
     done
     render_pair lit reference 48x27
+    # Image-based lighting and tone mapping: libm's sin, cos, acos, atan2 and log2 on both.
+    render_pair studio coverage 160x90
   else
-    for scene in default boxes slivers near_plane lit overlap sphere_closed; do
+    for scene in default boxes slivers near_plane lit overlap sphere_closed studio; do
       for mode in "${modes[@]}"; do render_pair "$scene" "$mode" 160x90; done
     done
     render_pair default reference 48x27

@@ -309,3 +309,22 @@ TEST_CASE("environment: the studio environment within 3/255 of brute-force quadr
   CHECK(worst_code <= 3);
   CHECK(worst_linear < 0.016);
 }
+
+TEST_CASE("environment: scenes/studio.json gives the same bytes for every thread count and tile",
+          "[environment][parallel]") {
+  const Scene scene = covrast::load_scene(std::string(COVRAST_SOURCE_DIR) + "/scenes/studio.json");
+  covrast::RenderOptions options;
+  options.width = 160;
+  options.height = 90;
+  options.threads = 1;
+  options.tile = 64;
+  const covrast::Image first = covrast::render(scene, options).color;
+  for (const auto& [threads, tile] : {std::pair{2, 16}, std::pair{3, 24}, std::pair{2, 128}}) {
+    INFO(threads << " threads, tile " << tile);
+    options.threads = threads;
+    options.tile = tile;
+    CHECK(covrast::render(scene, options).color.rgb == first.rgb);
+  }
+  // Lit by the environment: the gold sphere's middle is far from the background.
+  CHECK(int(first.pixel(80, 45)[0]) > 120);
+}
