@@ -12,6 +12,7 @@
 #include <cstdint>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -300,4 +301,33 @@ TEST_CASE("render options: the thread count is bounded by kMaxThreads", "[scene_
   CHECK_THROWS_WITH(covrast::Renderer(scene, options), Contains("thread count"));
   options.threads = -1;
   CHECK_THROWS_AS(covrast::Renderer(scene, options), InputError);
+}
+
+TEST_CASE("scene build: check_scene refuses a bad exposure or environment", "[scene_build]") {
+  covrast::Scene scene = empty_scene(8, 8);
+  covrast::check_scene(scene);
+  scene.exposure = 0.0;
+  CHECK_THROWS_WITH(covrast::check_scene(scene), Contains("exposure: must be a finite number > 0"));
+  scene.exposure = 1.0;
+  scene.environment = covrast::EnvironmentLight{covrast::studio_environment(), 30.0, 1.0};
+  covrast::check_scene(scene);
+  scene.environment->intensity = -1.0;
+  CHECK_THROWS_WITH(covrast::check_scene(scene),
+                    Contains("intensity must be a finite number >= 0"));
+  scene.environment->intensity = 1.0;
+  scene.environment->rotation_deg = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_WITH(covrast::check_scene(scene), Contains("rotation must be finite"));
+  scene.environment->rotation_deg = 0.0;
+  auto map = std::make_shared<covrast::EnvironmentMap>();
+  map->width = 4;
+  map->height = 2;
+  map->radiance_linear.assign(7, glm::vec3(1.0f));
+  scene.environment->map = map;
+  CHECK_THROWS_WITH(covrast::check_scene(scene), Contains("map of 4x2 with 7 texels"));
+  map->radiance_linear.assign(8, glm::vec3(1.0f));
+  covrast::check_scene(scene);
+  map->radiance_linear[3].g = std::numeric_limits<float>::quiet_NaN();
+  CHECK_THROWS_WITH(covrast::check_scene(scene), Contains("texels must be finite and >= 0"));
+  scene.environment->map = nullptr;
+  CHECK_THROWS_WITH(covrast::check_scene(scene), Contains("environment: no map"));
 }

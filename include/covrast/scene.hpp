@@ -365,8 +365,10 @@ void add_light(Scene& scene, Light light);
 
 /// Checks what load_scene would have refused in a scene built in code: the size (1..
 /// kMaxImageSide), the camera (Camera's comments; eye != target, up not parallel to the view
-/// direction), a background in 0..1, and each instance (a mesh, indices in range, array sizes
-/// that match, a finite affine model matrix, one material per mesh material). Throws
+/// direction), a background in 0..1, an exposure > 0, an environment as load_environment
+/// makes one (a map of width x height finite texels >= 0 within the limits, a finite rotation,
+/// an intensity >= 0), and each instance (a mesh, indices in range, array sizes that match, a
+/// finite affine model matrix, one material per mesh material). Throws
 /// InputError naming the first problem. O(triangles); the renderer does not call it.
 void check_scene(const Scene& scene);
 

@@ -120,6 +120,12 @@ void add_view_options(CLI::App* sub, ViewArgs& args);
 /// naming the option for bad values.
 void apply_view_args(Scene& scene, const ViewArgs& args);
 
+/// The warnings of a loaded scene: with `strict`, throws StrictWarningsError naming `what`
+/// and the first warning (main prints all of them after that one error line); otherwise
+/// prints each to stderr as "warning: ...".
+void report_scene_warnings(const std::string& what, const std::vector<std::string>& warnings,
+                           bool strict);
+
 /// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
 /// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x
 /// `height` when given (> 0), else 640x360.

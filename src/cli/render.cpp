@@ -166,15 +166,7 @@ int run_render(const RenderArgs& args) {
 
   Scene scene = load_scene_or_model(args.scene, options.width, options.height);
   apply_view_args(scene, args.view);
-  if (args.strict && !scene.warnings.empty()) {
-    // The error line first (main prints the warnings after it).
-    const std::size_t count = scene.warnings.size();
-    throw StrictWarningsError(
-        args.scene + ": --strict treats warnings as errors: " + scene.warnings.front() +
-            (count > 1 ? " (" + std::to_string(count) + " warnings below)" : ""),
-        scene.warnings);
-  }
-  for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
+  report_scene_warnings(args.scene, scene.warnings, args.strict);
 
   Renderer renderer(scene, options);
   const bool show_progress = args.repeat > 1 && ::isatty(STDERR_FILENO) == 1;

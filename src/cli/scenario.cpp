@@ -147,11 +147,7 @@ int run_scenario(const ScenarioArgs& args) {
   if (const auto it = scenario.find("renderSkybox"); it != scenario.end() && *it == true) {
     scene.warnings.push_back("scenario: renderSkybox is not drawn yet: the background stays white");
   }
-  if (args.strict && !scene.warnings.empty()) {
-    throw StrictWarningsError(
-        "scenario: --strict treats warnings as errors: " + scene.warnings.front(), scene.warnings);
-  }
-  for (const std::string& warning : scene.warnings) std::cerr << "warning: " << warning << '\n';
+  report_scene_warnings("scenario", scene.warnings, args.strict);
 
   const RenderResult result = render(scene, options);
   write_png(result.color, output);

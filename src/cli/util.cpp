@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <iostream>
 #include <string>
 #include <system_error>
 
@@ -34,6 +35,18 @@ bool is_mesh_file(const std::string& path) {
 Scene load_scene_or_model(const std::string& path, int width, int height) {
   if (!is_mesh_file(path)) return load_scene(path);
   return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360);
+}
+
+void report_scene_warnings(const std::string& what, const std::vector<std::string>& warnings,
+                           bool strict) {
+  if (strict && !warnings.empty()) {
+    const std::size_t count = warnings.size();
+    throw StrictWarningsError(
+        what + ": --strict treats warnings as errors: " + warnings.front() +
+            (count > 1 ? " (" + std::to_string(count) + " warnings below)" : ""),
+        warnings);
+  }
+  for (const std::string& warning : warnings) std::cerr << "warning: " << warning << '\n';
 }
 
 void check_output_path(const std::filesystem::path& path,

@@ -1,6 +1,7 @@
 // Image-based lighting: the moment pyramid for the irradiance, the radiance pyramid and the
 // filtered GGX estimates for the rest (the formulas are in core/environment_lighting.hpp).
 #include "core/environment_lighting.hpp"
+#include "core/pbr_terms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,8 +12,6 @@ namespace covrast::detail {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-/// The BRDF's smallest alpha, as in pbr_brdf (core/shading.cpp).
-constexpr double kMinAlpha = 1e-3;
 /// Finest moment cells: at most this many across (and half as many down). Cells the horizon
 /// cuts take max(0, n . m); their error is at most Omega_cell sin(radius) each.
 constexpr int kMomentCellsAcross = 64;
@@ -83,18 +82,10 @@ glm::dvec3 ggx_half_vector(double xi1, const glm::dvec2& azimuth, double alpha2,
   return t * (sin_h * azimuth.x) + b * (sin_h * azimuth.y) + n * cos_h;
 }
 
-/// V = 1 / ((n.l + sqrt(a2 + (1 - a2) (n.l)^2)) (n.v + sqrt(a2 + (1 - a2) (n.v)^2))), the
-/// specification's height-correlated Smith term, for n.l, n.v > 0.
+/// V = 1 / (g(n.l) g(n.v)), the specification's height-correlated Smith term, for n.l,
+/// n.v > 0.
 double smith_visibility(double n_dot_l, double n_dot_v, double alpha2) {
-  const double gl = n_dot_l + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_l * n_dot_l);
-  const double gv = n_dot_v + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_v * n_dot_v);
-  return 1.0 / (gl * gv);
-}
-
-double schlick5(double cos_theta) {
-  const double m = std::clamp(1.0 - cos_theta, 0.0, 1.0);
-  const double m2 = m * m;
-  return m2 * m2 * m;
+  return 1.0 / (smith_g(n_dot_l, alpha2) * smith_g(n_dot_v, alpha2));
 }
 
 /// The view direction with n . v = mu in the (x, z) plane of n = +Z.
@@ -123,7 +114,7 @@ UniformTables build_uniform_tables() {
   std::vector<std::vector<glm::dvec4>> half_vectors(kTableRoughnessNodes);
   for (int j = 0; j < kTableRoughnessNodes; ++j) {
     const double r = double(j) / double(kTableRoughnessNodes - 1);
-    const double alpha = std::max(r * r, kMinAlpha);
+    const double alpha = std::max(r * r, kMinBrdfAlpha);
     for (int k = 0; k < kTableSamples; ++k) {
       double cos_h = 0.0;
       const glm::dvec3 h = ggx_half_vector((k + 0.5) / kTableSamples, azimuths[std::size_t(k)],
@@ -142,12 +133,12 @@ UniformTables build_uniform_tables() {
       const glm::dvec2& azimuth = azimuths[std::size_t(k)];
       const glm::dvec3 l(sin_l * azimuth.x, sin_l * azimuth.y, cos_l);
       const glm::dvec3 h = glm::normalize(l + v);
-      s_sum += schlick5(std::abs(glm::dot(v, h)));
+      s_sum += schlick_weight(std::abs(glm::dot(v, h)));
     }
     tables.schlick_diffuse[std::size_t(i)] = s_sum / kTableSamples;
     for (int j = 0; j < kTableRoughnessNodes; ++j) {
       const double r = double(j) / double(kTableRoughnessNodes - 1);
-      const double alpha = std::max(r * r, kMinAlpha), alpha2 = alpha * alpha;
+      const double alpha = std::max(r * r, kMinBrdfAlpha), alpha2 = alpha * alpha;
       double a_sum = 0.0, b_sum = 0.0;
       for (const glm::dvec4& sample : half_vectors[std::size_t(j)]) {
         const glm::dvec3 h(sample);
@@ -159,7 +150,7 @@ UniformTables build_uniform_tables() {
         // f cos / pdf with pdf(l) = D (n.h) / (4 v.h): V (n.l) 4 (v.h) / (n.h).
         const double w = smith_visibility(l.z, mu, alpha2) * l.z * 4.0 * v_dot_h / cos_h;
         a_sum += w;
-        b_sum += w * schlick5(v_dot_h);
+        b_sum += w * schlick_weight(v_dot_h);
       }
       const std::size_t at = std::size_t(j) * kTableMuNodes + std::size_t(i);
       tables.specular[at] = a_sum / kTableSamples;
@@ -172,6 +163,65 @@ UniformTables build_uniform_tables() {
 const UniformTables& uniform_tables() {
   static const UniformTables tables = build_uniform_tables();  // thread-safe, once
   return tables;
+}
+
+/// Bilinear interpolation of an equirectangular grid of `width` x `height` values (texel
+/// centres at ((x + 0.5) / W, (y + 0.5) / H)) at `uv`: wrapping around in u, clamped at the
+/// poles in v. The radiance pyramid's levels and the irradiance nodes are both such grids.
+template <typename Value>
+glm::dvec3 equirect_bilinear(const std::vector<Value>& values, int width, int height,
+                             const glm::dvec2& uv) {
+  const double x = uv.x * width - 0.5, y = uv.y * height - 0.5;
+  const double x_floor = std::floor(x), y_floor = std::floor(y);
+  const double fx = x - x_floor, fy = y - y_floor;
+  auto wrap = [&](int xi) { return ((xi % width) + width) % width; };
+  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
+  const int y0 = std::clamp(int(y_floor), 0, height - 1);
+  const int y1 = std::clamp(int(y_floor) + 1, 0, height - 1);
+  auto at = [&](int xi, int yi) {
+    return glm::dvec3(values[std::size_t(yi) * std::size_t(width) + std::size_t(xi)]);
+  };
+  return (at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx) * (1.0 - fy) +
+         (at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx) * fy;
+}
+
+/// The texels of a W x H map that carry at least kSunPowerShare of its power (luminance x
+/// solid angle), at most kMaxSuns, brightest first (ties by index): each as a directional light
+/// of illuminance L Omega from its centre direction (map frame), and set to zero in `texels`.
+/// Only those few candidates are sorted.
+std::vector<EnvironmentSun> take_out_suns(std::vector<glm::vec3>& texels, int w, int h) {
+  const auto power_at = [&](std::size_t i, double omega) {
+    return luminance(glm::dvec3(texels[i])) * omega;
+  };
+  double total = 0.0;
+  for (int y = 0; y < h; ++y) {
+    const double omega = environment_texel_solid_angle(y, w, h);
+    for (int x = 0; x < w; ++x) total += power_at(std::size_t(y) * std::size_t(w) + x, omega);
+  }
+  struct Bright {
+    double power;
+    std::size_t index;
+  };
+  std::vector<Bright> bright;
+  for (int y = 0; y < h; ++y) {
+    const double omega = environment_texel_solid_angle(y, w, h);
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      const double power = power_at(i, omega);
+      if (power > 0.0 && power >= kSunPowerShare * total) bright.push_back({power, i});
+    }
+  }
+  std::sort(bright.begin(), bright.end(), [](const Bright& a, const Bright& b) {
+    return a.power != b.power ? a.power > b.power : a.index < b.index;
+  });
+  std::vector<EnvironmentSun> suns;
+  for (std::size_t k = 0; k < std::min(kMaxSuns, bright.size()); ++k) {
+    const int x = int(bright[k].index % std::size_t(w)), y = int(bright[k].index / std::size_t(w));
+    suns.push_back({environment_direction((x + 0.5) / w, (y + 0.5) / h),
+                    glm::dvec3(texels[bright[k].index]) * environment_texel_solid_angle(y, w, h)});
+    texels[bright[k].index] = glm::vec3(0.0f);
+  }
+  return suns;
 }
 
 }  // namespace
@@ -205,38 +255,10 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
   intensity_ = light.intensity;
   texel_solid_angle_ = 4.0 * kPi / (double(w) * double(h));
 
-  // Suns: the brightest texels by power, each at least kSunPowerShare of the total; they leave
-  // the map (set to zero in the copy the pyramids are built from).
+  // Suns: the brightest texels by power leave the map (zero in the copy the pyramids are
+  // built from).
   std::vector<glm::vec3> texels = map.radiance_linear;
-  {
-    double total = 0.0;
-    struct Bright {
-      double power;
-      std::size_t index;
-    };
-    std::vector<Bright> bright;
-    for (int y = 0; y < h; ++y) {
-      const double omega = environment_texel_solid_angle(y, w, h);
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-        const double power = luminance(glm::dvec3(texels[i])) * omega;
-        total += power;
-        bright.push_back({power, i});
-      }
-    }
-    std::sort(bright.begin(), bright.end(), [](const Bright& a, const Bright& b) {
-      return a.power != b.power ? a.power > b.power : a.index < b.index;
-    });
-    for (std::size_t k = 0; k < std::min(kMaxSuns, bright.size()); ++k) {
-      if (!(bright[k].power > 0.0) || bright[k].power < kSunPowerShare * total) break;
-      const int x = int(bright[k].index % std::size_t(w)),
-                y = int(bright[k].index / std::size_t(w));
-      const glm::dvec3 d = environment_direction((x + 0.5) / w, (y + 0.5) / h);
-      suns_.push_back(
-          {d, glm::dvec3(texels[bright[k].index]) * environment_texel_solid_angle(y, w, h)});
-      texels[bright[k].index] = glm::vec3(0.0f);
-    }
-  }
+  suns_ = take_out_suns(texels, w, h);
 
   // Radiance pyramid: each level halves the previous (rounding up), texels averaged with
   // their solid angles as weights.
@@ -331,13 +353,17 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
           (x + 0.5) / kIrradianceNodesAcross, (y + 0.5) / kIrradianceNodesDown)));
     }
   }
-  // The suns in the world frame: R_y(r) d, and x intensity.
+  // The suns in the world frame, and x intensity.
   for (EnvironmentSun& sun : suns_) {
-    const glm::dvec3 d = sun.to_light;
-    sun.to_light = {d.x * cos_rotation_ + d.z * sin_rotation_, d.y,
-                    -d.x * sin_rotation_ + d.z * cos_rotation_};
+    sun.to_light = to_world(sun.to_light);
     sun.irradiance *= intensity_;
   }
+}
+
+glm::dvec3 EnvironmentLighting::to_world(const glm::dvec3& d) const {
+  // R_y(r): the map turned into the world.
+  return {d.x * cos_rotation_ + d.z * sin_rotation_, d.y,
+          -d.x * sin_rotation_ + d.z * cos_rotation_};
 }
 
 glm::dvec3 EnvironmentLighting::to_map(const glm::dvec3& d) const {
@@ -355,21 +381,8 @@ glm::dvec3 EnvironmentLighting::irradiance(const glm::dvec3& n_world) const {
 }
 
 glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_world) const {
-  const glm::dvec2 uv = environment_uv(to_map(n_world));
-  const double x = uv.x * kIrradianceNodesAcross - 0.5, y = uv.y * kIrradianceNodesDown - 0.5;
-  const double x_floor = std::floor(x), y_floor = std::floor(y);
-  const double fx = x - x_floor, fy = y - y_floor;
-  auto wrap = [](int xi) {
-    return ((xi % kIrradianceNodesAcross) + kIrradianceNodesAcross) % kIrradianceNodesAcross;
-  };
-  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
-  const int y0 = std::clamp(int(y_floor), 0, kIrradianceNodesDown - 1);
-  const int y1 = std::clamp(int(y_floor) + 1, 0, kIrradianceNodesDown - 1);
-  auto node = [&](int xi, int yi) {
-    return irradiance_nodes_[std::size_t(yi) * kIrradianceNodesAcross + std::size_t(xi)];
-  };
-  return ((node(x0, y0) * (1.0 - fx) + node(x1, y0) * fx) * (1.0 - fy) +
-          (node(x0, y1) * (1.0 - fx) + node(x1, y1) * fx) * fy) *
+  return equirect_bilinear(irradiance_nodes_, kIrradianceNodesAcross, kIrradianceNodesDown,
+                           environment_uv(to_map(n_world))) *
          intensity_;
 }
 
@@ -409,18 +422,7 @@ glm::dvec3 EnvironmentLighting::walk_irradiance(const glm::dvec3& n) const {
 }
 
 glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level, const glm::dvec2& uv) const {
-  const double x = uv.x * level.width - 0.5, y = uv.y * level.height - 0.5;
-  const double x_floor = std::floor(x), y_floor = std::floor(y);
-  const double fx = x - x_floor, fy = y - y_floor;
-  auto wrap = [&](int xi) { return ((xi % level.width) + level.width) % level.width; };
-  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
-  const int y0 = std::clamp(int(y_floor), 0, level.height - 1);
-  const int y1 = std::clamp(int(y_floor) + 1, 0, level.height - 1);
-  auto texel = [&](int xi, int yi) {
-    return glm::dvec3(level.texels[std::size_t(yi) * std::size_t(level.width) + std::size_t(xi)]);
-  };
-  return (texel(x0, y0) * (1.0 - fx) + texel(x1, y0) * fx) * (1.0 - fy) +
-         (texel(x0, y1) * (1.0 - fx) + texel(x1, y1) * fx) * fy;
+  return equirect_bilinear(level.texels, level.width, level.height, uv);
 }
 
 glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) const {
@@ -455,7 +457,7 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
   const std::array<double, 3> uniform = uniform_environment_integrals(mu, roughness);
   out.irradiance_schlick = out.irradiance * (uniform[0] / kPi);
 
-  const double alpha = std::max(roughness * roughness, kMinAlpha), alpha2 = alpha * alpha;
+  const double alpha = std::max(roughness * roughness, kMinBrdfAlpha), alpha2 = alpha * alpha;
   glm::dvec3 t, b;
   tangent_frame(n, t, b);
   static const std::vector<glm::dvec2> azimuths = hammersley_azimuths(kSpecularSamples);
@@ -478,7 +480,7 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
         0.5 * std::log2(1.0 / (kSpecularSamples * pdf * texel_solid_angle_)) + kLodBias;
     const glm::dvec3 radiance = lookup(l, lod);
     const double w = smith_visibility(n_dot_l, mu, alpha2) * n_dot_l * 4.0 * v_dot_h / cos_h;
-    const double s = schlick5(v_dot_h);
+    const double s = schlick_weight(v_dot_h);
     a_sum += radiance * w;
     a_weight += w;
     b_sum += radiance * (w * s);

@@ -87,6 +87,7 @@ class EnvironmentLighting {
   };
 
   glm::dvec3 to_map(const glm::dvec3& d) const;
+  glm::dvec3 to_world(const glm::dvec3& d) const;
   glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
   /// E(n) of the map without suns for a unit normal in the map's frame, by the pyramid walk.
   glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;

@@ -5,6 +5,7 @@
 // ssaa and reference).
 #include "core/shading.hpp"
 #include "core/environment_lighting.hpp"
+#include "core/pbr_terms.hpp"
 #include "core/shading_inputs.hpp"
 
 #include <algorithm>
@@ -15,8 +16,6 @@ namespace covrast::detail {
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-/// Smallest BRDF roughness alpha (= perceptual roughness^2), see pbr_brdf.
-constexpr double kMinAlpha = 1e-3;
 
 /// What one punctual light delivers at a point: the unit direction towards it and the
 /// irradiance on a surface facing it, E = radiance x attenuation (KHR_lights_punctual).
@@ -47,13 +46,6 @@ Incident incident(const PunctualLight& light, const glm::dvec3& p) {
     attenuation *= cone * cone;
   }
   return {l, light.radiance * attenuation};
-}
-
-/// (1 - x)^5 by multiplication (the Schlick weight).
-double schlick_weight(double cos_theta) {
-  const double m = std::clamp(1.0 - cos_theta, 0.0, 1.0);
-  const double m2 = m * m;
-  return m2 * m2 * m;
 }
 
 /// base x (ambient x occlusion + sum_i E_i max(0, n . l_i)): Lambert without 1/pi, so that a
@@ -149,9 +141,9 @@ glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, c
                     const glm::dvec3& v, const glm::dvec3& l) {
   const glm::dvec3 c_diff = base * (1.0 - metallic);
   const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - metallic) + base * metallic;
-  // alpha = 0 (a perfect mirror) makes D = 0/0 where n = h: kept at kMinAlpha, a highlight
+  // alpha = 0 (a perfect mirror) makes D = 0/0 where n = h: kept at kMinBrdfAlpha, a highlight
   // one pixel wide that the resolve clamps.
-  const double alpha = std::max(roughness * roughness, kMinAlpha);
+  const double alpha = std::max(roughness * roughness, kMinBrdfAlpha);
   const double alpha2 = alpha * alpha;
   const glm::dvec3 h_sum = l + v;
   const double h_length = glm::length(h_sum);
@@ -163,8 +155,8 @@ glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, c
   double d_vis = 0.0;
   if (n_dot_h > 0.0 && h_dot_l > 0.0 && h_dot_v > 0.0) {
     const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
-    const double gl = n_dot_l + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_l * n_dot_l);
-    const double gv = n_dot_v + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_v * n_dot_v);
+    const double gl = smith_g(n_dot_l, alpha2);
+    const double gv = smith_g(n_dot_v, alpha2);
     d_vis = alpha2 / (kPi * k * k * (gl * gv));
   }
   return (glm::dvec3(1.0) - fresnel) * c_diff * (1.0 / kPi) + fresnel * d_vis;

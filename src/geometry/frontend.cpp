@@ -152,8 +152,7 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       height_px_(height_px),
       cull_hidden_backfaces_(cull_hidden_backfaces),
       eye_(scene.camera.eye) {
-  tone_mapping_ = {ToneMapOperator(int(scene.tone_map)), scene.exposure};
-  context_.tone_mapping = tone_mapping_;
+  context_.tone_mapping = {ToneMapOperator(int(scene.tone_map)), scene.exposure};
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
   const double aspect = double(width_px) / double(height_px);
@@ -717,10 +716,11 @@ void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
   t.convex_surface = sink.convex_surface;
   t.shading = nullptr;
   t.alpha_mode = TriangleAlpha::Opaque;
-  if (lit == nullptr && !tone_mapping_.is_identity()) {
+  if (const ToneMapping& mapping = context_.tone_mapping;
+      lit == nullptr && !mapping.is_identity()) {
     // Unlit colours are tone-mapped at the vertices (exact for uniform and per-triangle
     // colours; lit ones are tone-mapped where shade_lit makes them).
-    for (glm::vec3& c : t.color) c = glm::vec3(tone_map(tone_mapping_, glm::dvec3(c)));
+    for (glm::vec3& c : t.color) c = glm::vec3(tone_map(mapping, glm::dvec3(c)));
   }
   if (lit != nullptr) {
     // Computed only now, for triangles that survived every cull (half of a closed mesh's

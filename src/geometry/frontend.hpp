@@ -292,7 +292,6 @@ class GeometryFrontEnd {
   // m, pointing at context_; chunk_shading_[c]: the records of chunk c, written
   // only by setup_chunk(c).
   ShadingContext context_;
-  ToneMapping tone_mapping_;                        ///< the scene's, for unlit colours
   std::optional<EnvironmentLighting> environment_;  ///< context_.environment points here
   /// Single-sided materials per instance (set_single_sided): 0 none, 1 all, 2 some, with
   /// single_sided_triangles_[instance] flagging each triangle then.

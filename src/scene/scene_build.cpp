@@ -301,6 +301,36 @@ void add_light(Scene& scene, Light light) {
   scene.lights.push_back(light);
 }
 
+namespace {
+
+/// An environment as load_environment makes one: a map of W x H finite texels >= 0 within the
+/// limits, a finite rotation, a finite intensity >= 0.
+void check_environment(const EnvironmentLight& light) {
+  if (!light.map) fail("environment", "no map");
+  const EnvironmentMap& map = *light.map;
+  if (map.width < 1 || map.height < 1 || map.width > kMaxEnvironmentSide ||
+      map.height > kMaxEnvironmentSide ||
+      std::uint64_t(map.width) * std::uint64_t(map.height) > kMaxEnvironmentTexels ||
+      map.radiance_linear.size() != std::size_t(map.width) * std::size_t(map.height)) {
+    fail("environment", "map of " + std::to_string(map.width) + "x" + std::to_string(map.height) +
+                            " with " + std::to_string(map.radiance_linear.size()) +
+                            " texels: sides 1.." + std::to_string(kMaxEnvironmentSide) +
+                            ", width x height texels");
+  }
+  for (const glm::vec3& t : map.radiance_linear) {
+    if (!(t.r >= 0.0f && t.g >= 0.0f && t.b >= 0.0f) || !std::isfinite(t.r) ||
+        !std::isfinite(t.g) || !std::isfinite(t.b)) {
+      fail("environment", "texels must be finite and >= 0");
+    }
+  }
+  if (!std::isfinite(light.rotation_deg)) fail("environment", "rotation must be finite");
+  if (!(light.intensity >= 0.0) || !std::isfinite(light.intensity)) {
+    fail("environment", "intensity must be a finite number >= 0");
+  }
+}
+
+}  // namespace
+
 void check_scene(const Scene& scene) {
   if (scene.width < 1 || scene.width > kMaxImageSide || scene.height < 1 ||
       scene.height > kMaxImageSide) {
@@ -309,6 +339,10 @@ void check_scene(const Scene& scene) {
   }
   if (!in_unit_range(scene.background_linear)) fail("background", "must be in 0..1");
   check_camera(scene.camera);
+  if (!(scene.exposure > 0.0) || !std::isfinite(scene.exposure)) {
+    fail("exposure", "must be a finite number > 0");
+  }
+  if (scene.environment) check_environment(*scene.environment);
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];
     const std::string what = "meshes[" + std::to_string(i) + "]";
