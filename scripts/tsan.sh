@@ -7,7 +7,7 @@
 # counts and tiles, the parallel loop of the public API), then the command line rendering
 # bundled scenes in every mode on two threads. Any report fails the run (halt_on_error). oneTBB's own bookkeeping is
 # suppressed (tests/tsan.supp says why and how narrowly); covrast's hand-offs through TBB
-# are announced to TSan in src/pipeline/fork_join.hpp.
+# are announced to TSan in src/core/fork_join.hpp.
 # Usage: scripts/tsan.sh [BUILD_DIR]   (default build/tsan)
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."

@@ -1,6 +1,7 @@
 // Image-based lighting: the moment pyramid for the irradiance, the radiance pyramid and the
 // filtered GGX estimates for the rest (the formulas are in core/environment_lighting.hpp).
 #include "core/environment_lighting.hpp"
+#include "core/fork_join.hpp"
 #include "core/pbr_terms.hpp"
 
 #include <algorithm>
@@ -18,8 +19,22 @@ constexpr int kMomentCellsAcross = 64;
 /// The irradiance nodes: E at the centres of a 128 x 64 equirectangular grid of normals.
 constexpr int kIrradianceNodesAcross = 128;
 constexpr int kIrradianceNodesDown = 64;
-/// GGX directions per shading point for A and B.
-constexpr int kSpecularSamples = 256;
+/// Prefiltered radiance: node 0 is the map itself (a mirror); nodes k = 1..kPrefilterNodes are
+/// at perceptual roughness 2^((k - kPrefilterNodes) / 2), so alpha = roughness^2 doubles from
+/// one to the next (0.0156 .. 1): the lobes of neighbours differ by the same factor, and
+/// blending two of them stays close to the lobe between.
+constexpr int kPrefilterNodes = 7;
+/// A node's map is kPrefilterTexelsPerAlpha / alpha texels wide (its texels about alpha / 2
+/// radians apart, a fraction of the lobe), rounded up to a power of two and kept within
+/// [kPrefilterNarrowest, kPrefilterWidest] and the map's own width.
+constexpr double kPrefilterTexelsPerAlpha = 6.4;
+constexpr int kPrefilterWidest = 256;
+constexpr int kPrefilterNarrowest = 32;
+/// GGX directions per prefiltered texel: about kPrefilterBudget per node over its texels,
+/// within [kPrefilterFewest, kPrefilterMost] (the small maps of rough nodes get many).
+constexpr double kPrefilterBudget = 2.0e6;
+constexpr int kPrefilterFewest = 64;
+constexpr int kPrefilterMost = 1024;
 /// Added to the filtered-importance-sampling level (Krivanek and Colbert add 1).
 constexpr double kLodBias = 0.0;
 /// Uniform-light tables: n . v in [0, 1] and perceptual roughness in [0, 1], both at
@@ -31,6 +46,12 @@ constexpr int kTableSamples = 4096;
 constexpr double kSunPowerShare = 0.01;
 /// At most this many suns (the brightest); the rest stay in the map.
 constexpr std::size_t kMaxSuns = 16;
+
+double prefilter_node_roughness(int node) {
+  // sqrt(2^(node - nodes)): ldexp is exact and sqrt correctly rounded, so the same bits on
+  // every CPU.
+  return std::sqrt(std::ldexp(1.0, node - kPrefilterNodes));
+}
 
 double luminance(const glm::dvec3& c) { return 0.2126 * c.r + 0.7152 * c.g + 0.0722 * c.b; }
 
@@ -174,8 +195,10 @@ glm::dvec3 equirect_bilinear(const std::vector<Value>& values, int width, int he
   const double x = uv.x * width - 0.5, y = uv.y * height - 0.5;
   const double x_floor = std::floor(x), y_floor = std::floor(y);
   const double fx = x - x_floor, fy = y - y_floor;
-  auto wrap = [&](int xi) { return ((xi % width) + width) % width; };
-  const int x0 = wrap(int(x_floor)), x1 = wrap(int(x_floor) + 1);
+  // uv.x in [0, 1] puts x_floor in [-1, width - 1]: one step wraps it.
+  const int x_int = int(x_floor);
+  const int x0 = x_int < 0 ? width - 1 : std::min(x_int, width - 1);
+  const int x1 = x0 + 1 == width ? 0 : x0 + 1;
   const int y0 = std::clamp(int(y_floor), 0, height - 1);
   const int y1 = std::clamp(int(y_floor) + 1, 0, height - 1);
   auto at = [&](int xi, int yi) {
@@ -353,6 +376,7 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
           (x + 0.5) / kIrradianceNodesAcross, (y + 0.5) / kIrradianceNodesDown)));
     }
   }
+  build_prefiltered();
   // The suns in the world frame, and x intensity.
   for (EnvironmentSun& sun : suns_) {
     sun.to_light = to_world(sun.to_light);
@@ -436,6 +460,94 @@ glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) cons
   return a * (1.0 - t) + bilinear(radiance_[std::size_t(l0 + 1)], uv) * t;
 }
 
+void EnvironmentLighting::build_prefiltered() {
+  const int widest = std::min(floor_pow2(radiance_[0].width), kPrefilterWidest);
+  for (int node = 1; node <= kPrefilterNodes; ++node) {
+    const double roughness = prefilter_node_roughness(node);
+    const double alpha = std::max(roughness * roughness, kMinBrdfAlpha), alpha2 = alpha * alpha;
+    int width = kPrefilterNarrowest;
+    while (width < widest && width < kPrefilterTexelsPerAlpha / alpha) width *= 2;
+    RadianceLevel level{width, std::max(1, width / 2), {}};
+    const int samples =
+        std::clamp(floor_pow2(int(kPrefilterBudget / (double(width) * level.height))),
+                   kPrefilterFewest, kPrefilterMost);
+    const std::vector<PrefilterSample> lobe = prefilter_lobe(samples, alpha2);
+    level.texels.resize(std::size_t(level.width) * std::size_t(level.height));
+    // Rows are independent and each texel's sum runs in a fixed order: the same bits for
+    // every thread count.
+    fork_join_for(0, level.height, [&](int y) {
+      for (int x = 0; x < level.width; ++x) {
+        const glm::dvec3 r =
+            environment_direction((x + 0.5) / level.width, (y + 0.5) / level.height);
+        level.texels[std::size_t(y) * std::size_t(level.width) + std::size_t(x)] =
+            glm::vec3(prefilter_texel(r, lobe));
+      }
+    });
+    prefiltered_.push_back(std::move(level));
+  }
+}
+
+std::vector<EnvironmentLighting::PrefilterSample> EnvironmentLighting::prefilter_lobe(
+    int samples, double alpha2) const {
+  // n = v = r (the split-sum assumption): P(r) = sum L(l) w / sum w over GGX half vectors with
+  // w = V(n.l, 1) (n.l), the weight of A's estimator at n = v (Karis, "Real Shading in Unreal
+  // Engine 4", SIGGRAPH 2013 course notes, weights by n.l alone). In the frame of r a sample
+  // depends only on its index, so its direction, weight and pyramid level are computed here
+  // once per node: the level of its share of the sphere 1 / (N pdf), pdf(l) = D (n.h) / (4
+  // v.h) = D / 4 with v = n (filtered importance sampling).
+  const std::vector<glm::dvec2> azimuths = hammersley_azimuths(samples);
+  const glm::dvec3 n(0.0, 0.0, 1.0), t(1.0, 0.0, 0.0), b(0.0, 1.0, 0.0);
+  std::vector<PrefilterSample> lobe;
+  for (int k = 0; k < samples; ++k) {
+    double cos_h = 0.0;
+    const glm::dvec3 h =
+        ggx_half_vector((k + 0.5) / samples, azimuths[std::size_t(k)], alpha2, n, t, b, cos_h);
+    const double n_dot_l = 2.0 * cos_h * cos_h - 1.0;
+    if (!(n_dot_l > 0.0)) continue;
+    const double k_d = cos_h * cos_h * (alpha2 - 1.0) + 1.0;
+    const double pdf = alpha2 / (kPi * k_d * k_d) / 4.0;
+    const double lod = 0.5 * std::log2(1.0 / (samples * pdf * texel_solid_angle_)) + kLodBias;
+    lobe.push_back({h * (2.0 * cos_h) - n, smith_visibility(n_dot_l, 1.0, alpha2) * n_dot_l, lod});
+  }
+  return lobe;
+}
+
+glm::dvec3 EnvironmentLighting::prefilter_texel(const glm::dvec3& r,
+                                                const std::vector<PrefilterSample>& lobe) const {
+  glm::dvec3 t, b;
+  tangent_frame(r, t, b);
+  glm::dvec3 sum(0.0);
+  double weight = 0.0;
+  for (const PrefilterSample& sample : lobe) {
+    const glm::dvec3 l = t * sample.l_local.x + b * sample.l_local.y + r * sample.l_local.z;
+    sum += lookup(l, sample.lod) * sample.weight;
+    weight += sample.weight;
+  }
+  return weight > 0.0 ? sum / weight : lookup(r, 0.0);
+}
+
+glm::dvec3 EnvironmentLighting::prefiltered_radiance(const glm::dvec3& r_map,
+                                                     double roughness) const {
+  // Between the map and node 1 linear in roughness; between two nodes linear in log alpha;
+  // bilinear within each.
+  roughness = std::clamp(roughness, 0.0, 1.0);
+  const double first = prefilter_node_roughness(1);
+  int k0 = 0;
+  double t = roughness / first;
+  if (roughness >= first) {
+    const double x = kPrefilterNodes + 2.0 * std::log2(roughness);
+    k0 = std::clamp(int(x), 1, kPrefilterNodes - 1);
+    t = std::min(1.0, x - k0);
+  }
+  const glm::dvec2 uv = environment_uv(r_map);
+  auto node = [&](int k) {
+    const RadianceLevel& level = k == 0 ? radiance_[0] : prefiltered_[std::size_t(k - 1)];
+    return bilinear(level, uv);
+  };
+  const glm::dvec3 a = node(k0);
+  return t == 0.0 ? a : a * (1.0 - t) + node(k0 + 1) * t;
+}
+
 glm::dvec3 EnvironmentLighting::radiance(const glm::dvec3& d_world) const {
   return bilinear(radiance_[0], environment_uv(to_map(d_world))) * intensity_;
 }
@@ -457,39 +569,11 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
   const std::array<double, 3> uniform = uniform_environment_integrals(mu, roughness);
   out.irradiance_schlick = out.irradiance * (uniform[0] / kPi);
 
-  const double alpha = std::max(roughness * roughness, kMinBrdfAlpha), alpha2 = alpha * alpha;
-  glm::dvec3 t, b;
-  tangent_frame(n, t, b);
-  static const std::vector<glm::dvec2> azimuths = hammersley_azimuths(kSpecularSamples);
-  glm::dvec3 a_sum(0.0), b_sum(0.0);
-  double a_weight = 0.0, b_weight = 0.0;
-  for (int k = 0; k < kSpecularSamples; ++k) {
-    double cos_h = 0.0;
-    const glm::dvec3 h = ggx_half_vector((k + 0.5) / kSpecularSamples, azimuths[std::size_t(k)],
-                                         alpha2, n, t, b, cos_h);
-    const double v_dot_h = glm::dot(v, h);
-    if (!(v_dot_h > 0.0)) continue;
-    const glm::dvec3 l = h * (2.0 * v_dot_h) - v;
-    const double n_dot_l = glm::dot(n, l);
-    if (!(n_dot_l > 0.0)) continue;
-    // The sample's share of the sphere, 1 / (N pdf(l)), pdf(l) = D (n.h) / (4 v.h), sets the
-    // pyramid level: half of log2 of its ratio to a texel's, plus one (Krivanek and Colbert).
-    const double k_d = cos_h * cos_h * (alpha2 - 1.0) + 1.0;
-    const double pdf = alpha2 / (kPi * k_d * k_d) * cos_h / (4.0 * v_dot_h);
-    const double lod =
-        0.5 * std::log2(1.0 / (kSpecularSamples * pdf * texel_solid_angle_)) + kLodBias;
-    const glm::dvec3 radiance = lookup(l, lod);
-    const double w = smith_visibility(n_dot_l, mu, alpha2) * n_dot_l * 4.0 * v_dot_h / cos_h;
-    const double s = schlick_weight(v_dot_h);
-    a_sum += radiance * w;
-    a_weight += w;
-    b_sum += radiance * (w * s);
-    b_weight += w * s;
-  }
-  // The ratio estimator: exact when L is uniform.
-  const glm::dvec3 mirror = lookup(n * (2.0 * mu) - v, 0.0);
-  out.specular = (a_weight > 0.0 ? a_sum / a_weight : mirror) * (uniform[1] * intensity_);
-  out.specular_schlick = (b_weight > 0.0 ? b_sum / b_weight : mirror) * (uniform[2] * intensity_);
+  // Split sum: the radiance prefiltered around the mirror direction times the uniform-light
+  // values, exact when L is uniform.
+  const glm::dvec3 prefiltered = prefiltered_radiance(n * (2.0 * mu) - v, roughness) * intensity_;
+  out.specular = prefiltered * uniform[1];
+  out.specular_schlick = prefiltered * uniform[2];
   return out;
 }
 

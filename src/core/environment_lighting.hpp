@@ -15,15 +15,20 @@
 // horizon cuts are refined down to the finest cells, which take max(0, n . m). E is computed so
 // at the nodes of a 128 x 64 grid of normals and interpolated bilinearly between them (the
 // map without its suns is smooth after the cosine convolution).
-// A and B are estimated with a fixed set of 256 GGX-distributed directions (Hammersley) read
-// from a radiance pyramid at the level matching each direction's solid angle (filtered
-// importance sampling: Krivanek and Colbert, "Real-time shading with filtered importance
-// sampling", EGSR 2008) as ratio estimators: the weighted mean of the radiance times the
-// uniform-light value of the integral (tables computed once by dense quadrature). E_s is E
-// times its uniform-light ratio (the Schlick weight s varies slowly but at grazing angles).
-// So a uniform environment is integrated exactly (the white furnace), and the error elsewhere
-// is that of the filtered lookups and of E_s's ratio; docs/environments.md gives it as
-// measured against brute-force quadrature.
+// A and B are the split sum the glTF viewers compute (Karis, "Real Shading in Unreal Engine 4",
+// SIGGRAPH 2013 course notes): A = P(r, roughness) A_1(n.v, roughness), B likewise with B_1,
+// where A_1, B_1 are their values under uniform light (tables computed once by dense
+// quadrature) and P is the radiance prefiltered by the GGX lobe of a surface seen head-on
+// (n = v = r) around the mirror direction r, weighted by V (n.l) so that it is the lobe of A
+// itself at n = v (Karis weights by n.l alone). P is prepared at set-up in small
+// equirectangular maps at seven roughness nodes (alpha doubling from 1/64 to 1), each texel
+// by GGX directions read from a radiance pyramid at the level of each direction's solid angle
+// (filtered importance sampling: Krivanek and Colbert, "Real-time shading with filtered
+// importance sampling", EGSR 2008), and read at shading time bilinearly between two nodes.
+// E_s is E times its uniform-light ratio. A uniform environment is integrated exactly (the
+// white furnace); elsewhere the error is the split sum's (its lobe is that of n = v at every
+// view: at grazing views the true lobe is stretched and turned) and the prefiltering's;
+// docs/environments.md gives both as measured against brute-force quadrature.
 #pragma once
 
 #include <covrast/environment.hpp>
@@ -93,10 +98,22 @@ class EnvironmentLighting {
   glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;
   glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
   glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec2& uv) const;
+  /// One GGX direction of the prefiltering lobe, in the frame of the mirror direction (+Z).
+  struct PrefilterSample {
+    glm::dvec3 l_local;
+    double weight;  ///< V(n.l, 1) (n.l)
+    double lod;     ///< pyramid level of its share of the sphere
+  };
+  void build_prefiltered();
+  std::vector<PrefilterSample> prefilter_lobe(int samples, double alpha2) const;
+  glm::dvec3 prefilter_texel(const glm::dvec3& r, const std::vector<PrefilterSample>& lobe) const;
+  /// The radiance prefiltered by the GGX lobe of `roughness` around map direction r_map.
+  glm::dvec3 prefiltered_radiance(const glm::dvec3& r_map, double roughness) const;
 
   std::vector<EnvironmentSun> suns_;
   std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
   std::vector<RadianceLevel> radiance_;
+  std::vector<RadianceLevel> prefiltered_;    ///< nodes 1..kPrefilterNodes (node 0: radiance_[0])
   std::vector<glm::dvec3> irradiance_nodes_;  ///< walk_irradiance at the node normals
   double texel_solid_angle_ = 0.0;            ///< 4 pi / (W H) of level 0
   double cos_rotation_ = 1.0, sin_rotation_ = 0.0;

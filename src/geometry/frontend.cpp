@@ -327,6 +327,15 @@ static_assert(int(AlphaMode::Opaque) == int(TriangleAlpha::Opaque) &&
 
 }  // namespace
 
+void GeometryFrontEnd::prepare_environment() {
+  if (!lit_context_ || environment_) return;
+  if (scene_.environment && scene_.environment->map && scene_.environment->map->width > 0 &&
+      scene_.environment->map->height > 0) {
+    environment_.emplace(*scene_.environment);
+    context_.environment = &*environment_;
+  }
+}
+
 void GeometryFrontEnd::prepare_lighting() {
   context_.eye_world = eye_;
   if (scene_.camera.orthographic) {
@@ -334,11 +343,7 @@ void GeometryFrontEnd::prepare_lighting() {
     context_.orthographic = true;
     context_.to_eye = glm::normalize(scene_.camera.eye - scene_.camera.target);
   }
-  if (scene_.environment && scene_.environment->map && scene_.environment->map->width > 0 &&
-      scene_.environment->map->height > 0) {
-    environment_.emplace(*scene_.environment);
-    context_.environment = &*environment_;
-  }
+  lit_context_ = true;
   for (const Light& light : scene_.lights) {
     if (light.type == LightType::Ambient) {
       context_.ambient += glm::dvec3(light.color_linear) * light.intensity;

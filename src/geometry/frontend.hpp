@@ -165,6 +165,11 @@ class GeometryFrontEnd {
   }
   std::size_t instance_count() const { return scene_.meshes.size(); }
 
+  /// Prepares the scene's environment lighting (prefiltering runs in parallel: call it inside
+  /// the renderer's arena, before the first set-up). Does nothing without an environment or
+  /// when the scene is not shaded; a second call does nothing.
+  void prepare_environment();
+
   /// Transforms the vertices of one instance (vertices [begin, end)) to clip space. The range
   /// covers whole transform blocks (see kVerticesPerTransformBlock).
   void transform_vertices(std::size_t instance, std::size_t begin, std::size_t end);
@@ -293,6 +298,7 @@ class GeometryFrontEnd {
   // only by setup_chunk(c).
   ShadingContext context_;
   std::optional<EnvironmentLighting> environment_;  ///< context_.environment points here
+  bool lit_context_ = false;                        ///< prepare_lighting ran
   /// Single-sided materials per instance (set_single_sided): 0 none, 1 all, 2 some, with
   /// single_sided_triangles_[instance] flagging each triangle then.
   void prepare_single_sided();

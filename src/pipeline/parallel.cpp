@@ -1,6 +1,6 @@
 // Pipeline: running independent pieces of work at once (renderer.hpp, for_each_in_parallel),
 // so that programs on the public API, like covrast test, need no scheduler of their own.
-#include "fork_join.hpp"
+#include "core/fork_join.hpp"
 
 #include <covrast/renderer.hpp>
 

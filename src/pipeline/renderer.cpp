@@ -10,8 +10,8 @@
 // sequence, tiles of a fixed grid), and each task writes only its own output, so the image
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
+#include "core/fork_join.hpp"
 #include "core/tile_raster.hpp"
-#include "fork_join.hpp"
 #include "geometry/frontend.hpp"
 #include "post/fxaa.hpp"
 #include "raster/rasterizers.hpp"
@@ -136,6 +136,8 @@ struct Renderer::Impl {
     chunk_triangles.resize(front_end.chunk_count());
     chunk_bounds.resize(front_end.chunk_count());
     chunk_bins.resize(front_end.chunk_count());
+    // On the arena's threads, as many as the options allow.
+    detail::fork_join_execute(arena, [&] { front_end.prepare_environment(); });
   }
 
   /// The frame's image, all zeros, and its depth (1 = far) when the options ask for it.

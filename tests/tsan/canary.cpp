@@ -1,9 +1,9 @@
 // The TSan step's own check (scripts/tsan.sh): that the suppressions in tests/tsan.supp and
-// the annotations in src/pipeline/fork_join.hpp hide no race in covrast's code.
+// the annotations in src/core/fork_join.hpp hide no race in covrast's code.
 //   tsan_canary ordered: data handed to the tasks and back as oneTBB orders it, with no race;
 //                        must run without a report.
 //   tsan_canary racy:    tasks of one loop write one shared counter; must be reported.
-#include "pipeline/fork_join.hpp"
+#include "core/fork_join.hpp"
 
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/task_arena.h>

@@ -1,5 +1,6 @@
-// Pipeline: the oneTBB loops of the pipeline, with the ordering they guarantee told to
-// ThreadSanitizer, and the allowance that lets an explicit thread count exceed the cores.
+// The oneTBB loops of the pipeline and of set-up work (the environment's prefiltering), with the
+// ordering they guarantee told to ThreadSanitizer, and the allowance that lets an explicit
+// thread count exceed the cores. Low layer: it depends on oneTBB alone.
 //
 // oneTBB guarantees fork-join order: everything the caller did before a parallel_for (or a
 // task_arena::execute) happens before every task of it, and every task happens before the
