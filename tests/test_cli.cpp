@@ -509,10 +509,14 @@ TEST_CASE("cli: scenario renders the render-fidelity harness's JSON", "[cli]") {
   INFO("stderr: " << r.err);
   REQUIRE(r.exit_code == 0);
   const covrast::Image image = covrast::read_png(out);
-  // Twice the dimensions (the harness's device pixel ratio), white where nothing is drawn.
+  // Twice the dimensions (the harness's device pixel ratio), transparent where nothing is
+  // drawn (RGBA), opaque over the model.
   REQUIRE(image.width == 40);
   REQUIRE(image.height == 24);
-  for (int c = 0; c < 3; ++c) CHECK(image.pixel(0, 0)[c] == 255);
+  const covrast::RgbaImage rgba = covrast::read_image(out, "scenario output");
+  REQUIRE(rgba.rgba.size() == 40u * 24u * 4u);
+  CHECK(int(rgba.rgba[3]) == 0);
+  CHECK(int(rgba.rgba[(12u * 40u + 20u) * 4u + 3u]) == 255);
   // The same camera, light and tone map through `covrast render` shade the middle alike.
   const std::string rendered = (dir / "r.png").string();
   r = covrast::test::run_cli_in(
@@ -530,13 +534,21 @@ TEST_CASE("cli: scenario renders the render-fidelity harness's JSON", "[cli]") {
   r = covrast::test::run_cli_in(dir.path(), {"scenario", "scenario.json", "--quiet"}, true);
   CHECK(r.exit_code == 0);
   CHECK(fs::exists(out));
-  // renderSkybox is not drawn: a warning, an error with --strict.
+  // renderSkybox: the studio environment behind the model (RGB, no alpha), as `render
+  // --skybox` draws it.
   std::string skybox = scenario;
   const std::string no_skybox = "\"renderSkybox\": false";
   skybox.replace(skybox.find(no_skybox), no_skybox.size(), "\"renderSkybox\": true");
   r = covrast::test::run_cli_in(dir.path(), {"scenario", skybox, "--quiet", "--strict"}, true);
-  CHECK(r.exit_code == 2);
-  CHECK(r.err.find("renderSkybox") != std::string::npos);
+  CHECK(r.exit_code == 0);
+  r = covrast::test::run_cli_in(dir.path(),
+                                {"render", "tri.obj", "-o", rendered, "--size", "40x24", "--orbit",
+                                 "0,90,4", "--target", "0,0.25,0", "--fov", "40", "--environment",
+                                 "studio", "--tone-map", "khronos-pbr-neutral", "--skybox"},
+                                true);
+  REQUIRE(r.exit_code == 0);
+  CHECK(covrast::read_png(out).rgb == covrast::read_png(rendered).rgb);
+  CHECK(covrast::read_image(out, "sky").rgba[3] == 255);
   // Bad input: exit 2, one line.
   for (
       const std::string& bad :

@@ -39,7 +39,7 @@ double subpix_weight(double c, double subpix) {
 }
 
 Image filled(int width, int height, Rgb colour) {
-  Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * height * 3)};
+  Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * height * 3), {}};
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) std::copy(colour.begin(), colour.end(), image.pixel(x, y));
   }

@@ -33,7 +33,7 @@ struct NamedImage {
 };
 
 Image blank(int width, int height, Rgb colour) {
-  Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * height * 3)};
+  Image image{width, height, std::vector<std::uint8_t>(std::size_t(width) * height * 3), {}};
   for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = colour[i % 3];
   return image;
 }

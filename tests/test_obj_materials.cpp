@@ -133,7 +133,7 @@ TEST_CASE("OBJ mtllib/usemtl map Kd, Ks, Ns, Ke, d, map_Kd onto materials", "[ob
   dir.write("two.obj", kTwoMaterialObj);
   dir.write("scene.json", scene_of("two.obj").dump());
   std::filesystem::create_directories(dir / "textures");
-  covrast::write_png(covrast::Image{2, 2, std::vector<std::uint8_t>(12, 200)},
+  covrast::write_png(covrast::Image{2, 2, std::vector<std::uint8_t>(12, 200), {}},
                      dir / "textures/red.png");
   const covrast::Scene scene = covrast::load_scene(dir / "scene.json");
   const MeshData& mesh = *scene.meshes[0].mesh;
@@ -360,8 +360,8 @@ TEST_CASE("OBJ map_Kd file names with spaces are read whole, after the options (
           "[obj][mtl][textures]") {
   TempDir dir;
   std::vector<std::uint8_t> texels(4 * 4 * 3, 90);
-  covrast::write_png(covrast::Image{4, 4, texels}, dir / "my tex.png");
-  covrast::write_png(covrast::Image{4, 4, texels}, dir / "-dash.png");
+  covrast::write_png(covrast::Image{4, 4, texels, {}}, dir / "my tex.png");
+  covrast::write_png(covrast::Image{4, 4, texels, {}}, dir / "-dash.png");
   const std::string obj =
       "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl a\n"
       "f 1/1 2/1 3/1\n";
@@ -400,7 +400,7 @@ TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file, missing
   // One colour everywhere, so every filter and level of detail gives exactly that texel.
   std::vector<std::uint8_t> texels;
   for (int i = 0; i < 16; ++i) texels.insert(texels.end(), {200, 100, 50});
-  covrast::write_png(covrast::Image{4, 4, texels}, dir / "tex.png");
+  covrast::write_png(covrast::Image{4, 4, texels, {}}, dir / "tex.png");
   const covrast::Scene scene = covrast::load_scene(dir / "scene.json");
   const MeshData& mesh = *scene.meshes[0].mesh;
   REQUIRE(mesh.materials.size() >= 2);

@@ -11,11 +11,15 @@
 
 namespace covrast {
 
-/// 8-bit sRGB-encoded RGB image, row 0 at the top, rows packed (stride = 3 * width).
+/// 8-bit sRGB-encoded RGB image, row 0 at the top, rows packed (stride = 3 * width), with an
+/// optional alpha plane.
 struct Image {
   int width = 0;
   int height = 0;
   std::vector<std::uint8_t> rgb;
+  /// Empty: opaque (PNG RGB). Else one linear 8-bit alpha per pixel, the colour not
+  /// premultiplied (PNG RGBA): a transparent background (Scene::background_kind).
+  std::vector<std::uint8_t> alpha;
   std::uint8_t* pixel(int x, int y) { return &rgb[(std::size_t(y) * width + x) * 3]; }
   const std::uint8_t* pixel(int x, int y) const { return &rgb[(std::size_t(y) * width + x) * 3]; }
 };

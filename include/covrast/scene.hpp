@@ -216,11 +216,21 @@ struct MeshInstance {
   std::shared_ptr<const std::vector<glm::vec3>> corner_normals;
 };
 
+/// What shows where no surface covers a pixel (docs/scene-format.md, "background").
+enum class BackgroundKind : std::uint8_t {
+  Color,        ///< Scene::background_linear, a display colour (not tone-mapped)
+  Transparent,  ///< nothing: RGBA output whose alpha is the share of each pixel surfaces cover
+  Skybox,       ///< the environment through the pixel's centre, tone-mapped as surfaces are
+};
+
 struct Scene {
   std::filesystem::path source;  ///< the JSON file (empty when built in code)
   int width = 640;               ///< [pixels], 1..kMaxImageSide
   int height = 360;              ///< [pixels], 1..kMaxImageSide
   glm::vec3 background_linear{0.0f};
+  /// Transparent and Skybox render the frame twice (post/background.hpp); Skybox needs an
+  /// environment.
+  BackgroundKind background_kind = BackgroundKind::Color;
   Camera camera;
   std::vector<MeshInstance> meshes;
   /// A scene with a "lights" key is lit (even with an empty list: then only emission

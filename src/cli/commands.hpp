@@ -30,6 +30,8 @@ struct ViewArgs {
   std::optional<double> fov_deg;
   std::string tone_map;
   std::optional<double> exposure;
+  bool transparent = false;  ///< BackgroundKind::Transparent
+  bool skybox = false;       ///< BackgroundKind::Skybox
 };
 
 struct RenderArgs {

@@ -84,7 +84,8 @@ CLI::App* add_scenario_command(CLI::App& app, ScenarioArgs& args) {
       "'{\"scenario\": {...}, \"outputFile\": \"out.png\"}' or a file holding it. The image is "
       "2 x width by 2 x height (the harness's device pixel ratio), lit by the scenario's "
       "lighting (the built-in studio environment without one), tone-mapped with "
-      "khronos-pbr-neutral, on a white background (docs/environments.md)");
+      "khronos-pbr-neutral, over a transparent background (RGBA) or, with renderSkybox, the "
+      "environment (docs/environments.md)");
   sub->add_option("scenario", args.scenario, "The harness's JSON argument, or a file with it")
       ->required()
       ->type_name("ARG");
@@ -140,13 +141,15 @@ int run_scenario(const ScenarioArgs& args) {
     view.environment = string_at(scenario, "lighting", "");
   }
   view.tone_map = args.tone_map;
-  apply_view_args(scene, view);
-  // The harness compares only where the candidate is not transparent and blends with white
-  // where it is; until covrast writes alpha, a white background is what matches it there.
-  scene.background_linear = glm::vec3(1.0f);
-  if (const auto it = scenario.find("renderSkybox"); it != scenario.end() && *it == true) {
-    scene.warnings.push_back("scenario: renderSkybox is not drawn yet: the background stays white");
+  // renderSkybox (default false): the environment behind the model, else a transparent
+  // background, which the harness's metric skips in the candidate.
+  const auto skybox = scenario.find("renderSkybox");
+  if (skybox != scenario.end() && !skybox->is_boolean() && !skybox->is_null()) {
+    throw InputError("scenario: renderSkybox: expected true or false");
   }
+  view.skybox = skybox != scenario.end() && *skybox == true;
+  view.transparent = !view.skybox;
+  apply_view_args(scene, view);
   report_scene_warnings("scenario", scene.warnings, args.strict);
 
   const RenderResult result = render(scene, options);

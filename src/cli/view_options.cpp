@@ -65,6 +65,13 @@ void apply_view_args(Scene& scene, const ViewArgs& args) {
     scene.camera.fovy_deg = *args.fov_deg;
     scene.camera.orthographic = false;
   }
+  if (args.transparent) scene.background_kind = BackgroundKind::Transparent;
+  if (args.skybox) {
+    if (!scene.environment) {
+      throw InputError("--skybox needs an environment: --environment FILE|studio, or the scene's");
+    }
+    scene.background_kind = BackgroundKind::Skybox;
+  }
   const glm::dvec3 target =
       args.target.empty() ? scene.camera.target : parse_triple(args.target, "--target");
   if (!args.orbit.empty()) {
@@ -102,6 +109,13 @@ void add_view_options(CLI::App* sub, ViewArgs& args) {
   sub->add_option("--exposure", args.exposure,
                   "Multiply linear radiance by X before the tone map (default 1)")
       ->type_name("X");
+  CLI::Option* transparent =
+      sub->add_flag("--transparent", args.transparent,
+                    "Transparent background: an RGBA PNG whose alpha is the share of each pixel "
+                    "the model covers (the frame is rendered twice; docs/scene-format.md)");
+  sub->add_flag("--skybox", args.skybox,
+                "Show the environment behind the model, tone-mapped (the frame is rendered twice)")
+      ->excludes(transparent);
 }
 
 }  // namespace covrast::cli

@@ -249,6 +249,16 @@ std::vector<EnvironmentSun> take_out_suns(std::vector<glm::vec3>& texels, int w,
 
 }  // namespace
 
+glm::dvec3 environment_radiance(const EnvironmentLight& light, const glm::dvec3& d_world) {
+  // The map turned by R_y(rotation) into the world: look up R_y(-rotation) d.
+  const double rotation = light.rotation_deg * (kPi / 180.0);
+  const double c = std::cos(rotation), s = std::sin(rotation);
+  const glm::dvec3 d_map(d_world.x * c - d_world.z * s, d_world.y, d_world.x * s + d_world.z * c);
+  const EnvironmentMap& map = *light.map;
+  return equirect_bilinear(map.radiance_linear, map.width, map.height, environment_uv(d_map)) *
+         light.intensity;
+}
+
 std::array<double, 3> uniform_environment_integrals(double mu, double roughness) {
   const UniformTables& tables = uniform_tables();
   const double x = std::clamp(mu, 0.0, 1.0) * (kTableMuNodes - 1);
@@ -546,10 +556,6 @@ glm::dvec3 EnvironmentLighting::prefiltered_radiance(const glm::dvec3& r_map,
   };
   const glm::dvec3 a = node(k0);
   return t == 0.0 ? a : a * (1.0 - t) + node(k0 + 1) * t;
-}
-
-glm::dvec3 EnvironmentLighting::radiance(const glm::dvec3& d_world) const {
-  return bilinear(radiance_[0], environment_uv(to_map(d_world))) * intensity_;
 }
 
 EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,

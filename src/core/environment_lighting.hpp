@@ -69,9 +69,6 @@ class EnvironmentLighting {
   EnvironmentIntegrals integrals(const glm::dvec3& n_world, const glm::dvec3& v_world,
                                  double roughness) const;
 
-  /// The radiance arriving from world direction d, bilinear at the finest level (skybox).
-  glm::dvec3 radiance(const glm::dvec3& d_world) const;
-
   /// The texels taken out of the map as directional lights (integrals() leaves them out;
   /// irradiance() includes them): each holds at least kSunPowerShare of the map's power.
   const std::vector<EnvironmentSun>& suns() const { return suns_; }
@@ -119,6 +116,10 @@ class EnvironmentLighting {
   double cos_rotation_ = 1.0, sin_rotation_ = 0.0;
   double intensity_ = 1.0;
 };
+
+/// The radiance of `light` arriving from unit world direction d (turned and scaled as the
+/// light says), bilinear in its map with the suns left in: what a skybox shows.
+glm::dvec3 environment_radiance(const EnvironmentLight& light, const glm::dvec3& d_world);
 
 /// Uniform-light values (L = 1) of E_s, A and B for n . v = mu and perceptual roughness r:
 /// {int s (n.l)+ dl / pi, int D V (n.l)+ dl, int s D V (n.l)+ dl}.

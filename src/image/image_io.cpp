@@ -257,8 +257,24 @@ void check_png_text(const PngText& record) {
 
 Bytes encode_png_rgb8(const Image& image, const std::vector<PngText>& text) {
   for (const PngText& record : text) check_png_text(record);
-  return encode_png_file(image.rgb.data(), image.rgb.size(), image.width, image.height,
-                         SPNG_COLOR_TYPE_TRUECOLOR, 8, SPNG_FILTER_CHOICE_NONE, text);
+  if (image.alpha.empty()) {
+    return encode_png_file(image.rgb.data(), image.rgb.size(), image.width, image.height,
+                           SPNG_COLOR_TYPE_TRUECOLOR, 8, SPNG_FILTER_CHOICE_NONE, text);
+  }
+  std::vector<std::uint8_t> rgba(image.alpha.size() * 4);
+  for (std::size_t i = 0; i < image.alpha.size(); ++i) {
+    std::copy_n(&image.rgb[3 * i], 3, &rgba[4 * i]);
+    rgba[4 * i + 3] = image.alpha[i];
+  }
+  return encode_png_file(rgba.data(), rgba.size(), image.width, image.height,
+                         SPNG_COLOR_TYPE_TRUECOLOR_ALPHA, 8, SPNG_FILTER_CHOICE_NONE, text);
+}
+
+/// The RGB plane holds 3 values per pixel, the alpha plane none or 1.
+void check_image_planes(const Image& image, const std::string& what) {
+  check_image_shape(image.width, image.height, image.rgb.size(), 3, what);
+  if (!image.alpha.empty())
+    check_image_shape(image.width, image.height, image.alpha.size(), 1, what);
 }
 
 std::uint32_t read_be32(const std::uint8_t* p) {
@@ -268,13 +284,13 @@ std::uint32_t read_be32(const std::uint8_t* p) {
 }  // namespace
 
 std::vector<std::uint8_t> encode_png(const Image& image, const std::vector<PngText>& text) {
-  check_image_shape(image.width, image.height, image.rgb.size(), 3, "PNG");
+  check_image_planes(image, "PNG");
   return encode_png_rgb8(image, text);
 }
 
 void write_png(const Image& image, const std::filesystem::path& path,
                const std::vector<PngText>& text) {
-  check_image_shape(image.width, image.height, image.rgb.size(), 3, path);
+  check_image_planes(image, path.string());
   write_atomically(path, encode_png_rgb8(image, text));
 }
 

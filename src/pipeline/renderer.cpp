@@ -10,9 +10,12 @@
 // sequence, tiles of a fixed grid), and each task writes only its own output, so the image
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
+#include "core/environment_lighting.hpp"
 #include "core/fork_join.hpp"
 #include "core/tile_raster.hpp"
+#include "core/tone_map.hpp"
 #include "geometry/frontend.hpp"
+#include "post/background.hpp"
 #include "post/fxaa.hpp"
 #include "raster/rasterizers.hpp"
 
@@ -88,6 +91,27 @@ void post_process_fxaa(const FxaaOptions& options, Image& input, detail::LumaPla
   detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
     detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end(), kernels);
   });
+}
+
+/// The skybox behind pixel (x, y): the environment's radiance along the ray through the
+/// pixel's centre (orthographic: along the view direction), exposed and tone-mapped as the
+/// shaded colours are.
+glm::dvec3 sky_at(const Scene& scene, int width_px, int height_px, int x, int y) {
+  const Camera& cam = scene.camera;
+  const glm::dvec3 forward = glm::normalize(cam.target - cam.eye);
+  glm::dvec3 d = forward;
+  if (!cam.orthographic) {
+    const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));
+    const glm::dvec3 up = glm::cross(right, forward);
+    const double half_h = std::tan(0.5 * cam.fovy_deg * (3.14159265358979323846 / 180.0));
+    const double half_w = half_h * double(width_px) / double(height_px);
+    const double ndc_x = 2.0 * (x + 0.5) / width_px - 1.0;
+    const double ndc_y = 1.0 - 2.0 * (y + 0.5) / height_px;
+    d = glm::normalize(forward + right * (ndc_x * half_w) + up * (ndc_y * half_h));
+  }
+  const detail::ToneMapping mapping{detail::ToneMapOperator(int(scene.tone_map)), scene.exposure};
+  const glm::dvec3 radiance = detail::environment_radiance(*scene.environment, d);
+  return mapping.is_identity() ? radiance : detail::tone_map(mapping, radiance);
 }
 
 }  // namespace
@@ -311,8 +335,14 @@ RenderResult Renderer::render_frame() {
   Impl& im = *impl_;
   RenderResult result = im.blank_result();
   // The background is a display colour (a clear colour), not tone-mapped (docs/shading.md).
+  // A transparent or skybox background renders the frame over black, then again over white
+  // (post/background.hpp): set-up and binning are shared, the tile pass runs twice.
+  const bool keyed = im.scene.background_kind != BackgroundKind::Color;
+  Image over_white;
+  if (keyed) over_white = result.color;
   const detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
-                                   im.scene.background_linear};
+                                   keyed ? glm::vec3(0.0f) : im.scene.background_linear};
+  const detail::FrameTarget white_target{&over_white, nullptr, glm::vec3(1.0f)};
   const std::uint64_t overflows_before = im.begin_frame_counters();
   Clock::time_point t0, t1, t2, t3, t4;
   detail::fork_join_execute(im.arena, [&] {
@@ -322,9 +352,21 @@ RenderResult Renderer::render_frame() {
     im.bin_triangles();
     t2 = Clock::now();
     im.raster_tiles(target);
+    if (keyed) im.raster_tiles(white_target);
     t3 = Clock::now();
     if (im.options.mode.kind == ModeKind::Fxaa) {
       post_process_fxaa(im.options.fxaa, im.post_input, im.post_luma, result.color);
+      if (keyed) post_process_fxaa(im.options.fxaa, im.post_input, im.post_luma, over_white);
+    }
+    if (im.scene.background_kind == BackgroundKind::Transparent) {
+      const Image over_black = result.color;
+      detail::key_transparent(over_black, over_white, result.color);
+    } else if (im.scene.background_kind == BackgroundKind::Skybox) {
+      const Image over_black = result.color;
+      detail::key_skybox(
+          over_black, over_white,
+          [&](int x, int y) { return sky_at(im.scene, im.width_px, im.height_px, x, y); },
+          result.color);
     }
     t4 = Clock::now();
   });

@@ -343,6 +343,9 @@ void check_scene(const Scene& scene) {
     fail("exposure", "must be a finite number > 0");
   }
   if (scene.environment) check_environment(*scene.environment);
+  if (scene.background_kind == BackgroundKind::Skybox && !scene.environment) {
+    fail("background", "a skybox needs an environment");
+  }
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];
     const std::string what = "meshes[" + std::to_string(i) + "]";

@@ -914,7 +914,16 @@ Scene scene_from_root(const json& root, const std::string& file,
   scene.width = reader.image_side(root, "width");
   scene.height = reader.image_side(root, "height");
   if (const auto it = root.find("background"); it != root.end()) {
-    scene.background_linear = reader.srgb_color(*it, "background");
+    if (it->is_string() && *it == "transparent") {
+      scene.background_kind = BackgroundKind::Transparent;
+    } else if (it->is_string() && *it == "skybox") {
+      scene.background_kind = BackgroundKind::Skybox;
+    } else if (it->is_string()) {
+      fail(file, "background",
+           "expected [r,g,b], \"transparent\" or \"skybox\", got " + shown(*it));
+    } else {
+      scene.background_linear = reader.srgb_color(*it, "background");
+    }
   }
   const json& camera = reader.required(root, "camera", "camera");
   const bool camera_from_gltf = camera.is_object() && camera.contains("gltf");
