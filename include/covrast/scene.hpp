@@ -249,9 +249,21 @@ struct Scene {
   std::size_t triangle_count() const;
 };
 
+/// A moment of a glTF file's animations to pose its meshes at (docs/scene-format.md,
+/// "Animation"); a scene file's "animation" and "time" keys. Without one, glTF files are drawn
+/// in their static pose.
+struct AnimationTime {
+  int index = -1;       ///< >= 0: the animation with this index
+  std::string name{};   ///< index < 0 and non-empty: the animation with this name; else the first
+  double time_s = 0.0;  ///< seconds, finite, >= 0; before the first keyframe the first values
+};
+
 /// Loads a scene file. Throws InputError with a one-line message naming the file and the
 /// problem (with line and column for malformed JSON).
 Scene load_scene(const std::filesystem::path& json_path);
+
+/// load_scene with `pose` in the place of the file's "animation" and "time" keys.
+Scene load_scene(const std::filesystem::path& json_path, const AnimationTime& pose);
 
 /// Mesh files that load_scene has loaded, kept for later scenes that use the same files: a
 /// program that loads many scenes (covrast test) then reads and parses each file once. Files
@@ -282,7 +294,8 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 /// (studio_environment()); the file's materials (OBJ without materials: lambert).
 /// docs/scene-format.md, "Rendering a mesh file without a scene", has the numbers. Throws
 /// InputError as load_scene.
-Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360);
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360,
+                      const std::optional<AnimationTime>& pose = std::nullopt);
 
 /// The orbit camera of the glTF viewers (model-viewer's camera-orbit, the render-fidelity
 /// harness): target + radius (sin(phi) sin(theta), cos(phi), sin(phi) cos(theta)), angles in

@@ -30,8 +30,10 @@ struct ViewArgs {
   std::optional<double> fov_deg;
   std::string tone_map;
   std::optional<double> exposure;
-  bool transparent = false;  ///< BackgroundKind::Transparent
-  bool skybox = false;       ///< BackgroundKind::Skybox
+  bool transparent = false;      ///< BackgroundKind::Transparent
+  bool skybox = false;           ///< BackgroundKind::Skybox
+  std::optional<double> time_s;  ///< --time: pose glTF files at this moment
+  std::string animation;         ///< --animation INDEX|NAME
 };
 
 struct RenderArgs {
@@ -131,7 +133,10 @@ void report_scene_warnings(const std::string& what, const std::vector<std::strin
 /// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
 /// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x
 /// `height` when given (> 0), else 640x360.
-Scene load_scene_or_model(const std::string& path, int width = 0, int height = 0);
+/// `view`'s --time and --animation pose glTF files (AnimationTime), in a scene file in the
+/// place of its "animation" and "time" keys.
+Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int width = 0,
+                          int height = 0);
 
 /// Throws InputError unless `path` could be created or replaced: its directory exists, is a
 /// directory and is writable, the path is not a directory, and its extension (lower case) is

@@ -249,7 +249,7 @@ CLI::App* add_info_command(CLI::App& app, InfoArgs& args) {
 }
 
 int run_info(const InfoArgs& args) {
-  Scene scene = load_scene_or_model(args.scene);
+  Scene scene = load_scene_or_model(args.scene, args.view);
   apply_view_args(scene, args.view);
   const Bounds bounds = world_bounds(scene);
   std::size_t total_vertices = 0;

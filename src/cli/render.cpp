@@ -164,7 +164,7 @@ int run_render(const RenderArgs& args) {
   check_output_path(args.output, {".png"});
   if (options.want_depth) check_output_path(args.depth, {".png", ".pfm"});
 
-  Scene scene = load_scene_or_model(args.scene, options.width, options.height);
+  Scene scene = load_scene_or_model(args.scene, args.view, options.width, options.height);
   apply_view_args(scene, args.view);
   report_scene_warnings(args.scene, scene.warnings, args.strict);
 

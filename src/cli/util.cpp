@@ -32,9 +32,24 @@ bool is_mesh_file(const std::string& path) {
 
 }  // namespace
 
-Scene load_scene_or_model(const std::string& path, int width, int height) {
-  if (!is_mesh_file(path)) return load_scene(path);
-  return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360);
+Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int width, int height) {
+  std::optional<AnimationTime> pose;
+  if (view.time_s || !view.animation.empty()) {
+    pose.emplace();
+    pose->time_s = view.time_s.value_or(0.0);
+    if (!(pose->time_s >= 0.0) || !std::isfinite(pose->time_s)) {
+      throw InputError("--time: expected a finite number of seconds >= 0");
+    }
+    const std::string& a = view.animation;
+    if (!a.empty() && a.size() <= 9 &&
+        std::all_of(a.begin(), a.end(), [](unsigned char c) { return std::isdigit(c) != 0; })) {
+      pose->index = std::stoi(a);
+    } else {
+      pose->name = a;
+    }
+  }
+  if (!is_mesh_file(path)) return pose ? load_scene(path, *pose) : load_scene(path);
+  return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360, pose);
 }
 
 void report_scene_warnings(const std::string& what, const std::vector<std::string>& warnings,

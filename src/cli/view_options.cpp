@@ -113,6 +113,13 @@ void add_view_options(CLI::App* sub, ViewArgs& args) {
       sub->add_flag("--transparent", args.transparent,
                     "Transparent background: an RGBA PNG whose alpha is the share of each pixel "
                     "the model covers (the frame is rendered twice; docs/scene-format.md)");
+  sub->add_option("--time", args.time_s,
+                  "Pose glTF files at this moment of an animation (seconds; the static pose "
+                  "without it; docs/scene-format.md, \"Animation\")")
+      ->type_name("SECONDS");
+  sub->add_option("--animation", args.animation,
+                  "Which animation --time samples: an index or a name (default: the first)")
+      ->type_name("INDEX|NAME");
   sub->add_flag("--skybox", args.skybox,
                 "Show the environment behind the model, tone-mapped (the frame is rendered twice)")
       ->excludes(transparent);

@@ -9,6 +9,7 @@
 // glTF colours are linear already (glTF 2.0 spec, 3.7.2.1 and 5.19.3). Every buffer access goes
 // through gltf_accessors.hpp, bounds-checked, so a broken file is an InputError, never a crash.
 #include "scene/gltf_accessors.hpp"
+#include "scene/gltf_animation.hpp"
 #include "scene/gltf_draco.hpp"
 #include "scene/gltf_input.hpp"
 #include "scene/gltf_lights.hpp"
@@ -952,15 +953,18 @@ class GltfMeshBuilder {
 }  // namespace
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir) {
+                      const std::filesystem::path& base_dir, const GltfPoseRequest* pose) {
   std::string warn;
-  const tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
+  tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);
+  std::vector<std::string> pose_warnings;
+  if (pose != nullptr) pose_at_time(model, display_name, *pose, pose_warnings);
   const std::vector<int> roots = root_nodes(model, display_name);
   GltfMeshBuilder builder(model, display_name, base_dir);
   builder.add_node_trees(roots);
   LoadedMesh loaded = builder.finish();
   add_loader_warnings(warn, display_name, loaded.warnings);
+  loaded.warnings.insert(loaded.warnings.end(), pose_warnings.begin(), pose_warnings.end());
   return loaded;
 }
 

@@ -1,6 +1,7 @@
 // Scene file loader: parses the JSON scene format (docs/scene-format.md), validates every field
 // with a one-line InputError naming the file and the JSON key, converts sRGB display colours to
 // linear light, and loads each mesh file once however many instances name it.
+#include "scene/gltf_animation.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
@@ -554,9 +555,11 @@ namespace {
 /// passes each file's warnings to this scene on its first use here.
 class SceneMeshes {
  public:
+  /// `pose`: the moment glTF files are posed at (null: their static pose).
   SceneMeshes(const std::string& file, std::filesystem::path base_dir,
-              std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files)
-      : file_(file), base_dir_(std::move(base_dir)), files_(files) {}
+              std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files,
+              const detail::GltfPoseRequest* pose)
+      : file_(file), base_dir_(std::move(base_dir)), files_(files), pose_(pose) {}
 
   /// The mesh that entry `key` names.
   CachedMesh& get(const MeshFileRef& ref, const std::string& key, Scene& scene) {
@@ -564,7 +567,15 @@ class SceneMeshes {
     std::error_code ec;
     const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
     if (ec) fail(file_, key, "cannot open '" + ref.relative + "': " + ec.message());
-    const auto id = std::make_pair(canonical.string(), ref.format);
+    // A glTF file posed at a moment of an animation is another mesh than its static pose.
+    std::string id_path = canonical.string();
+    if (pose_ != nullptr && ref.format == MeshFormat::Gltf) {
+      std::ostringstream moment;
+      moment.precision(17);
+      moment << '\n' << pose_->index << '\n' << pose_->name << '\n' << pose_->time_s;
+      id_path += moment.str();
+    }
+    const auto id = std::make_pair(id_path, ref.format);
     auto cached = files_.find(id);
     if (cached == files_.end()) {
       CachedMesh loaded_mesh;
@@ -603,13 +614,15 @@ class SceneMeshes {
       fail(file_, key, "cannot open '" + ref.relative + "': " + error);
     }
     const std::string display = full.lexically_normal().string();
-    return ref.format == MeshFormat::Obj ? detail::parse_obj(bytes, display, full.parent_path())
-                                         : detail::parse_gltf(bytes, display, full.parent_path());
+    return ref.format == MeshFormat::Obj
+               ? detail::parse_obj(bytes, display, full.parent_path())
+               : detail::parse_gltf(bytes, display, full.parent_path(), pose_);
   }
 
   const std::string& file_;
   std::filesystem::path base_dir_;
   std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files_;
+  const detail::GltfPoseRequest* pose_;
   std::set<std::pair<std::string, MeshFormat>> warned_;
 };
 
@@ -902,6 +915,43 @@ EnvironmentLight scene_environment(const std::string& file, const json& value,
   return light;
 }
 
+/// The root's "animation" (an index or a name) and "time" (seconds >= 0): either makes glTF
+/// files posed at that moment; neither, their static pose.
+std::optional<detail::GltfPoseRequest> animation_time(const std::string& file, const json& root,
+                                                      const SceneReader& reader) {
+  const auto animation = root.find("animation");
+  const auto time = root.find("time");
+  if (animation == root.end() && time == root.end()) return std::nullopt;
+  detail::GltfPoseRequest pose;
+  if (animation != root.end()) {
+    if (animation->is_string()) {
+      pose.name = animation->get<std::string>();
+      if (pose.name.empty()) fail(file, "animation", "expected an index or a non-empty name");
+    } else if (animation->is_number_integer() && animation->get<std::int64_t>() >= 0 &&
+               animation->get<std::int64_t>() <= std::int64_t(1) << 30) {
+      pose.index = int(animation->get<std::int64_t>());
+    } else {
+      fail(file, "animation", "expected an index >= 0 or a name, got " + shown(*animation));
+    }
+  }
+  if (time != root.end()) {
+    pose.time_s = reader.number(*time, "time");
+    if (!(pose.time_s >= 0.0)) fail(file, "time", "expected seconds >= 0, got " + shown(*time));
+  }
+  return pose;
+}
+
+/// The root with `pose` in the place of its "animation" and "time" keys.
+void set_animation_time(json& root, const AnimationTime& pose) {
+  root.erase("animation");
+  if (pose.index >= 0) {
+    root["animation"] = pose.index;
+  } else if (!pose.name.empty()) {
+    root["animation"] = pose.name;
+  }
+  root["time"] = pose.time_s;
+}
+
 /// load_scene's work on a parsed root: `file` names it in messages, mesh paths are relative to
 /// `base_dir`, meshes come from and go to `files`. `cameras`, if given, receives the first glTF
 /// entry's cameras (load_mesh_scene looks for one there).
@@ -952,7 +1002,8 @@ Scene scene_from_root(const json& root, const std::string& file,
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  SceneMeshes cache(file, base_dir, files);
+  const std::optional<detail::GltfPoseRequest> pose = animation_time(file, root, reader);
+  SceneMeshes cache(file, base_dir, files, pose ? &*pose : nullptr);
   FirstGltf first_gltf;
   std::uint64_t triangles = 0;
   for (std::size_t i = 0; i < meshes.size(); ++i) {
@@ -977,14 +1028,17 @@ Scene scene_from_root(const json& root, const std::string& file,
 
 }  // namespace
 
-Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
+namespace {
+
+Scene load_scene_posed(const std::filesystem::path& json_path, MeshFiles& files,
+                       const AnimationTime* pose) {
   // Every JSON access checks its type first; this is the net under them, so that a missed
   // check is still an input error naming the file, not an internal error.
   try {
     const std::string file = json_path.string();
-    const json root = read_scene_root(json_path, file);
-    Scene scene =
-        scene_from_root(root, file, json_path.parent_path(), mesh_files.impl_->files, nullptr);
+    json root = read_scene_root(json_path, file);
+    if (pose != nullptr) set_animation_time(root, *pose);
+    Scene scene = scene_from_root(root, file, json_path.parent_path(), files, nullptr);
     scene.source = json_path;
     warn_beyond_finite_range(scene);
     return scene;
@@ -993,7 +1047,19 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
   }
 }
 
-Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height) {
+}  // namespace
+
+Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_files) {
+  return load_scene_posed(json_path, mesh_files.impl_->files, nullptr);
+}
+
+Scene load_scene(const std::filesystem::path& json_path, const AnimationTime& pose) {
+  MeshFiles files;
+  return load_scene_posed(json_path, files, &pose);
+}
+
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
+                      const std::optional<AnimationTime>& pose) {
   const std::string file = mesh_path.string();
   std::string ext = mesh_path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -1020,6 +1086,7 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
                  {"far", 10}}},
                {"meshes", json::array({{{gltf ? "gltf" : "obj", mesh_path.filename().string()}}})}};
   if (gltf) root["lights"] = "gltf";
+  if (pose) set_animation_time(root, *pose);
   MeshFiles files;  // the second pass below takes the parsed file from here
   std::vector<detail::FileCamera> cameras;
   Scene scene = scene_from_root(root, file, mesh_path.parent_path(), files, &cameras);
