@@ -245,9 +245,23 @@ struct Scene {
   std::size_t dropped_nonfinite_triangles = 0;
   /// One line each, e.g. "meshes/a.obj: dropped 3 triangles with NaN/Inf coordinates".
   std::vector<std::string> warnings;
+  /// The glTF extensions the scene's files list in extensionsUsed, sorted, each once
+  /// (gltf_extension_support says what covrast does with each).
+  std::vector<std::string> gltf_extensions_used;
 
   std::size_t triangle_count() const;
 };
+
+/// What covrast does with a glTF extension a file uses (docs/scene-format.md, "glTF
+/// extensions"): Honoured (read and drawn as its specification says), Ignored (the file is
+/// drawn without it, as `effect` says, with a warning), Unreadable (a file that requires it is
+/// refused; one that uses it optionally is drawn without it, with a warning).
+enum class GltfExtensionSupport : std::uint8_t { Honoured, Ignored, Unreadable };
+struct GltfExtensionStatus {
+  GltfExtensionSupport support;
+  std::string effect;  ///< what a file using it gets, one line
+};
+GltfExtensionStatus gltf_extension_support(const std::string& name);
 
 /// A moment of a glTF file's animations to pose its meshes at (docs/scene-format.md,
 /// "Animation"); a scene file's "animation" and "time" keys. Without one, glTF files are drawn

@@ -17,6 +17,18 @@
 namespace covrast::cli {
 namespace {
 
+const char* support_name(GltfExtensionSupport support) {
+  switch (support) {
+    case GltfExtensionSupport::Honoured:
+      return "honoured";
+    case GltfExtensionSupport::Ignored:
+      return "ignored";
+    case GltfExtensionSupport::Unreadable:
+      return "cannot read";
+  }
+  return "ignored";
+}
+
 struct Bounds {
   glm::dvec3 min{std::numeric_limits<double>::infinity()};
   glm::dvec3 max{-std::numeric_limits<double>::infinity()};
@@ -173,6 +185,12 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
   } else {
     j["bounds"] = {{"min", vec_json(bounds.min)}, {"max", vec_json(bounds.max)}};
   }
+  j["gltf_extensions"] = nlohmann::ordered_json::array();
+  for (const std::string& name : scene.gltf_extensions_used) {
+    const GltfExtensionStatus status = gltf_extension_support(name);
+    j["gltf_extensions"].push_back(
+        {{"name", name}, {"support", support_name(status.support)}, {"effect", status.effect}});
+  }
   j["warnings"] = scene.warnings;
   return j;
 }
@@ -225,6 +243,12 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
   } else {
     std::cout << "bounds:      min " << vec_text(bounds.min) << ", max " << vec_text(bounds.max)
               << " (world)\n";
+  }
+  std::cout << "extensions:  " << (scene.gltf_extensions_used.empty() ? "none" : "") << '\n';
+  for (const std::string& name : scene.gltf_extensions_used) {
+    const GltfExtensionStatus status = gltf_extension_support(name);
+    std::cout << "  " << name << ": " << support_name(status.support) << " (" << status.effect
+              << ")\n";
   }
   std::cout << "warnings:    " << (scene.warnings.empty() ? "none" : "") << '\n';
   for (const std::string& warning : scene.warnings) std::cout << "  " << warning << '\n';

@@ -240,6 +240,23 @@ void check_required_extensions(const tinygltf::Model& model, const std::string& 
   }
 }
 
+/// Records the file's extensionsUsed, and a warning for each one covrast does not honour
+/// (a material extension only matters, and warns, in a lit scene): nothing is left out
+/// without a word.
+void add_extension_warnings(const tinygltf::Model& model, const std::string& name,
+                            LoadedMesh& loaded) {
+  for (const std::string& extension : model.extensionsUsed) {
+    loaded.extensions_used.push_back(extension);
+    const GltfExtensionStatus status = gltf_extension_support(extension);
+    if (status.support == GltfExtensionSupport::Honoured) continue;
+    const bool material = extension.rfind("KHR_materials_", 0) == 0;
+    (material ? loaded.lit_warnings : loaded.warnings)
+        .push_back(name + ": uses the glTF extension " + printable(extension) + ", which covrast " +
+                   (status.support == GltfExtensionSupport::Ignored ? "ignores" : "cannot read") +
+                   ": " + status.effect);
+  }
+}
+
 /// Where the node walk starts: the chosen scene's nodes, or every node that is nobody's child
 /// when the file has no scene.
 std::vector<int> root_nodes(const tinygltf::Model& model, const std::string& name) {
@@ -965,6 +982,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   LoadedMesh loaded = builder.finish();
   add_loader_warnings(warn, display_name, loaded.warnings);
   loaded.warnings.insert(loaded.warnings.end(), pose_warnings.begin(), pose_warnings.end());
+  add_extension_warnings(model, display_name, loaded);
   return loaded;
 }
 

@@ -57,6 +57,8 @@ struct LoadedMesh {
   std::vector<FileCamera> cameras;
   /// glTF: the lights on the walked nodes, in walk order.
   std::vector<FileLight> lights;
+  /// glTF: the file's extensionsUsed, as listed.
+  std::vector<std::string> extensions_used;
 };
 
 /// core/file_read.hpp's readers, with the loaders' limit as the default (a later

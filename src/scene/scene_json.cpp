@@ -596,6 +596,11 @@ class SceneMeshes {
                                " triangles with NaN/Inf coordinates");
     }
     for (const std::string& warning : loaded.warnings) scene.warnings.push_back(warning);
+    for (const std::string& extension : loaded.extensions_used) {
+      auto& used = scene.gltf_extensions_used;
+      const auto at = std::lower_bound(used.begin(), used.end(), extension);
+      if (at == used.end() || *at != extension) used.insert(at, extension);
+    }
     // Nothing loads as empty without a word (a file of the wrong kind, wrong JSON types).
     if (loaded.data->triangle_count() == 0) {
       scene.warnings.push_back(full.lexically_normal().string() +

@@ -1,0 +1,69 @@
+// What covrast does with each glTF extension (docs/scene-format.md, "glTF extensions"): the
+// one table behind the loader's warnings and `covrast info`.
+#include <covrast/scene.hpp>
+
+#include <array>
+#include <string_view>
+
+namespace covrast {
+namespace {
+
+struct KnownExtension {
+  std::string_view name;
+  GltfExtensionSupport support;
+  std::string_view effect;
+};
+
+constexpr std::string_view kCoreMaterial =
+    "drawn with the core metallic-roughness material, without the extension's layer";
+constexpr std::string_view kFallbackImage =
+    "each texture uses its core image, the fallback the extension asks files to give";
+
+constexpr std::array<KnownExtension, 28> kKnown{{
+    {"EXT_mesh_gpu_instancing", GltfExtensionSupport::Honoured, "instances drawn"},
+    {"KHR_draco_mesh_compression", GltfExtensionSupport::Honoured, "decoded (libdraco)"},
+    {"KHR_lights_punctual", GltfExtensionSupport::Honoured,
+     "lights used with \"lights\": \"gltf\""},
+    {"KHR_materials_emissive_strength", GltfExtensionSupport::Honoured, "emission scaled"},
+    {"KHR_materials_unlit", GltfExtensionSupport::Honoured, "unlit materials"},
+    {"KHR_mesh_quantization", GltfExtensionSupport::Honoured, "quantized attributes read"},
+    {"KHR_texture_transform", GltfExtensionSupport::Honoured, "texture transforms applied"},
+    {"KHR_materials_anisotropy", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_clearcoat", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_diffuse_transmission", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_dispersion", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_ior", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_iridescence", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_pbrSpecularGlossiness", GltfExtensionSupport::Ignored,
+     "drawn with the core metallic-roughness material the file gives beside it"},
+    {"KHR_materials_sheen", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_specular", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_materials_transmission", GltfExtensionSupport::Ignored,
+     "drawn opaque: what is behind does not show through"},
+    {"KHR_materials_variants", GltfExtensionSupport::Ignored, "the default materials are drawn"},
+    {"KHR_materials_volume", GltfExtensionSupport::Ignored, kCoreMaterial},
+    {"KHR_animation_pointer", GltfExtensionSupport::Ignored,
+     "its channels are not animated (--time poses the core channels)"},
+    {"KHR_xmp_json_ld", GltfExtensionSupport::Ignored, "metadata: nothing to draw"},
+    {"KHR_xmp", GltfExtensionSupport::Ignored, "metadata: nothing to draw"},
+    {"KHR_texture_basisu", GltfExtensionSupport::Unreadable, kFallbackImage},
+    {"EXT_texture_webp", GltfExtensionSupport::Unreadable, kFallbackImage},
+    {"EXT_texture_avif", GltfExtensionSupport::Unreadable, kFallbackImage},
+    {"EXT_meshopt_compression", GltfExtensionSupport::Unreadable,
+     "the uncompressed fallback buffers are read; without them the file does not load"},
+    {"KHR_meshopt_compression", GltfExtensionSupport::Unreadable,
+     "the uncompressed fallback buffers are read; without them the file does not load"},
+    {"EXT_lights_image_based", GltfExtensionSupport::Ignored,
+     "its environment is not used (give one with --environment)"},
+}};
+
+}  // namespace
+
+GltfExtensionStatus gltf_extension_support(const std::string& name) {
+  for (const KnownExtension& known : kKnown) {
+    if (known.name == name) return {known.support, std::string(known.effect)};
+  }
+  return {GltfExtensionSupport::Ignored, "unknown to covrast: drawn without it"};
+}
+
+}  // namespace covrast
