@@ -224,6 +224,44 @@ TEST_CASE("background: a skybox shows the environment through each pixel's centr
   CHECK(worst <= 1);
 }
 
+TEST_CASE("background: a skybox in every mode, the same bytes for every thread count and tile",
+          "[background][threads]") {
+  // A uniform environment: wherever only the sky shows, every mode shows its colour.
+  auto map = std::make_shared<covrast::EnvironmentMap>();
+  map->width = 8;
+  map->height = 4;
+  map->radiance_linear.assign(32, glm::vec3(0.1f, 0.4f, 0.7f));
+  Scene scene = triangle_scene(BackgroundKind::Color);
+  scene.environment = covrast::EnvironmentLight{map, 0.0, 1.0};
+  scene.background_kind = BackgroundKind::Skybox;
+  const std::uint8_t sky[3] = {covrast::detail::encode_srgb8(0.1f),
+                               covrast::detail::encode_srgb8(0.4f),
+                               covrast::detail::encode_srgb8(0.7f)};
+  for (const std::string mode :
+       {"coverage", "coverage-blend", "aliased", "ssaa:4", "msaa:4", "reference", "fxaa"}) {
+    INFO(mode);
+    const Image first = render_mode(scene, mode, 1, 64);
+    CHECK(first.alpha.empty());
+    int sky_pixels = 0;
+    for (int y = 0; y < kHeight; ++y) {
+      for (int x = 0; x < kWidth; ++x) {
+        bool near = false;
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx)
+            near = near || covered_share(kTriangle, x + dx, y + dy) > 0.0;
+        }
+        if (near) continue;
+        ++sky_pixels;
+        for (int c = 0; c < 3; ++c) CHECK(int(first.pixel(x, y)[c]) == int(sky[c]));
+      }
+    }
+    CHECK(sky_pixels > 300);
+    for (const int threads : {2, 3}) {
+      CHECK(render_mode(scene, mode, threads, 24).rgb == first.rgb);
+    }
+  }
+}
+
 TEST_CASE("background: a skybox needs an environment", "[background]") {
   Scene scene = triangle_scene(BackgroundKind::Color);
   scene.background_kind = BackgroundKind::Skybox;
