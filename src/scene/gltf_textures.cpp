@@ -219,6 +219,18 @@ std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool
     textures_.emplace(key, it->second);
     return it->second;
   }
+  // A missing image file changes how the model looks, not what it is: drawn without it, with
+  // a warning (--strict: an error), as a missing OBJ material library or map_Kd.
+  if (!image.uri.empty() && image.uri.rfind("data:", 0) != 0 && image.bufferView < 0) {
+    std::error_code ec;
+    const std::filesystem::path file = base_dir_ / percent_decoded(image.uri);
+    if (!std::filesystem::exists(file, ec) && !ec) {
+      warnings_.push_back(image_name + ": no such file: its texture slots are drawn without it");
+      textures_.emplace(key, nullptr);
+      by_source_.emplace(source, nullptr);
+      return nullptr;
+    }
+  }
   // The decoded bytes become level 0 (moved, not copied): nothing else keeps them.
   RgbaImage rgba = decode(image, image_name);
   // The file's decoded images together stay within kMaxTextureTexels, checked before this

@@ -29,12 +29,14 @@ bool keep_image_bytes(tinygltf::Image* image, const int image_index, std::string
 /// space, shared by every material slot that uses it.
 class GltfTextures {
  public:
+  /// `warnings` receives a line for each image file that does not exist.
   GltfTextures(const tinygltf::Model& model, const GltfReader& reader,
-               std::filesystem::path base_dir)
-      : model_(model), reader_(reader), base_dir_(std::move(base_dir)) {}
+               std::filesystem::path base_dir, std::vector<std::string>& warnings)
+      : model_(model), reader_(reader), base_dir_(std::move(base_dir)), warnings_(warnings) {}
 
-  /// Fills the texture slots of `material` from `source`. Throws InputError naming the file
-  /// and the image when an image is missing or cannot be decoded.
+  /// Fills the texture slots of `material` from `source`. An image file that does not exist
+  /// leaves its slots empty with a warning (docs/limits.md, "Missing files"); one that cannot
+  /// be read or decoded is an InputError naming the file and the image.
   void apply(const tinygltf::Material& source, int material_index, Material& material);
 
  private:
@@ -48,6 +50,7 @@ class GltfTextures {
   const tinygltf::Model& model_;
   const GltfReader& reader_;
   std::filesystem::path base_dir_;
+  std::vector<std::string>& warnings_;
   std::map<std::pair<int, bool>, std::shared_ptr<const Texture>> textures_;
   std::map<std::pair<std::string, bool>, std::shared_ptr<const Texture>> by_source_;
   std::uint64_t texels_ = 0;  ///< level-0 texels of the textures decoded so far

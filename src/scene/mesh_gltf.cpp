@@ -240,6 +240,31 @@ void check_required_extensions(const tinygltf::Model& model, const std::string& 
   }
 }
 
+/// tinygltf notes an image file it cannot open twice ("File not found : URI", "Failed to load
+/// external 'uri' for image[N] ..."); where covrast has reported that image itself ("image N
+/// (URI): no such file", gltf_textures.cpp), its notes say nothing more and are dropped. Notes
+/// on images no material uses stay: they are the only word on them.
+void drop_notes_on_missing_images(const std::string& name, std::vector<std::string>& warnings) {
+  const std::string file_note = name + ": File not found : ";
+  const std::string load_note = name + ": Failed to load external 'uri' for image[";
+  const std::vector<std::string> all = warnings;  // looked up while `warnings` shrinks
+  auto reported = [&](const std::string& fragment) {
+    return std::any_of(all.begin(), all.end(), [&](const std::string& w) {
+      return w.find(fragment) != std::string::npos &&
+             w.find("): no such file") != std::string::npos;
+    });
+  };
+  std::erase_if(warnings, [&](const std::string& w) {
+    if (w.rfind(file_note, 0) == 0) return reported("(" + w.substr(file_note.size()) + ")");
+    if (w.rfind(load_note, 0) == 0) {
+      const std::size_t end = w.find(']', load_note.size());
+      return end != std::string::npos &&
+             reported(": image " + w.substr(load_note.size(), end - load_note.size()) + " (");
+    }
+    return false;
+  });
+}
+
 /// Records the file's extensionsUsed, and a warning for each one covrast does not honour
 /// (a material extension only matters, and warns, in a lit scene): nothing is left out
 /// without a word.
@@ -313,7 +338,7 @@ class GltfMeshBuilder {
     mesh_->source = name;
     // The file's materials with their textures (each image decoded once), then glTF's default
     // material for primitives without one.
-    GltfTextures textures(model, reader_, base_dir);
+    GltfTextures textures(model, reader_, base_dir, warnings_);
     for (std::size_t i = 0; i < model.materials.size(); ++i) {
       const std::string& mode = model.materials[i].alphaMode;
       if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND") {
@@ -981,6 +1006,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   builder.add_node_trees(roots);
   LoadedMesh loaded = builder.finish();
   add_loader_warnings(warn, display_name, loaded.warnings);
+  drop_notes_on_missing_images(display_name, loaded.warnings);
   loaded.warnings.insert(loaded.warnings.end(), pose_warnings.begin(), pose_warnings.end());
   add_extension_warnings(model, display_name, loaded);
   return loaded;

@@ -18,6 +18,7 @@
 #include <cstdlib>
 #include <limits>
 #include <map>
+#include <set>
 #include <vector>
 
 namespace covrast::detail {
@@ -189,20 +190,32 @@ class ObjParser {
 
  private:
   /// map_Kd (sRGB, docs/textures.md): each distinct file decoded once and shared by the
-  /// materials naming it; a missing or undecodable image is an InputError naming it.
+  /// materials naming it. A file that does not exist is a warning and its materials are drawn
+  /// without it (docs/limits.md, "Missing files"); one that cannot be read or decoded is an
+  /// InputError naming it.
   void load_color_maps(MeshData& mesh, LoadedMesh& loaded) const {
     std::map<std::string, std::shared_ptr<const Texture>> maps;
+    std::set<std::string> missing;
     std::uint64_t texels = 0;  // of the file's decoded maps, within kMaxTextureTexels
     std::size_t without_uvs = 0;
     for (Material& m : mesh.materials) {
       if (m.base_color_texture_path.empty()) continue;
+      if (missing.count(m.base_color_texture_path) != 0) continue;
       std::shared_ptr<const Texture>& texture = maps[m.base_color_texture_path];
       if (!texture) {
         // Named relative to the OBJ file, as the .mtl usually gives it (short enough to print).
         const std::filesystem::path path(m.base_color_texture_path);
         std::string shown = path.lexically_relative(base_dir_).string();
         if (shown.empty()) shown = path.filename().string();
-        texture = load_texture_file(path, name_ + ": map_Kd " + printable(shown), true, texels);
+        const std::string what = name_ + ": map_Kd " + printable(shown);
+        std::error_code ec;
+        if (!std::filesystem::exists(path, ec) && !ec) {
+          loaded.warnings.push_back(what + ": no such file: its materials are drawn without it");
+          missing.insert(m.base_color_texture_path);
+          maps.erase(m.base_color_texture_path);
+          continue;
+        }
+        texture = load_texture_file(path, what, true, texels);
       }
       m.base_color_texture.texture = texture;
       without_uvs += any_face_uv_ ? 0 : 1;
