@@ -2,6 +2,7 @@
 // whose metrics are known exactly or computed independently here from the sRGB formula.
 #include <covrast/compare.hpp>
 #include <covrast/error.hpp>
+#include <covrast/image.hpp>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>
@@ -11,9 +12,12 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <iterator>
 #include <string>
 #include <utility>
+
+#include "test_tempdir.hpp"
 
 namespace {
 
@@ -229,4 +233,34 @@ TEST_CASE("to_json is one line that parses back to the result", "[compare]") {
     CHECK(json.at("share_over_1").get<double>() == 0.25);
     CHECK(json.at("share_over_8").get<double>() == 0.125);
   }
+}
+
+TEST_CASE("compare: alpha is a fourth channel when either image has it, and PNGs keep it",
+          "[compare]") {
+  Image a = make_image(4, 2, {10, 20, 30});
+  Image b = a;
+  a.alpha.assign(8, 255);
+  b.alpha.assign(8, 255);
+  b.alpha[5] = 200;  // colours equal, one alpha 55 lower
+  const CompareResult r = covrast::compare_images(a, b);
+  CHECK(r.max_diff_srgb8 == 55);
+  CHECK(r.pixels_over_8 == 1);
+  // Four channels of eight pixels, one off by 55/255 in linear units.
+  CHECK(r.rmse_linear == Approx(std::sqrt((55.0 / 255.0) * (55.0 / 255.0) / 32.0)));
+  // An image without alpha compares as opaque.
+  Image opaque = make_image(4, 2, {10, 20, 30});
+  CHECK(covrast::compare_images(opaque, a).max_diff_srgb8 == 0);
+  CHECK(covrast::compare_images(opaque, b).max_diff_srgb8 == 55);
+  // RGB images compare over three channels, as before.
+  CHECK(covrast::compare_images(opaque, opaque).rmse_linear == 0.0);
+  // A PNG written with alpha reads back with it (RGBA), one without it without.
+  const covrast::test::TempDir dir("covrast-compare");
+  const std::filesystem::path with = dir / "alpha.png";
+  const std::filesystem::path without = dir / "opaque.png";
+  covrast::write_png(b, with);
+  covrast::write_png(opaque, without);
+  const Image back = covrast::read_png(with);
+  CHECK(back.rgb == b.rgb);
+  CHECK(back.alpha == b.alpha);
+  CHECK(covrast::read_png(without).alpha.empty());
 }

@@ -9,6 +9,8 @@
 
 namespace covrast {
 
+/// When either image has an alpha plane (a transparent background), alpha is a fourth channel
+/// of every measure (255 for an image without one); RGB images compare as before.
 struct CompareResult {
   int width = 0;
   int height = 0;

@@ -61,7 +61,8 @@ inline constexpr std::uint64_t kMaxPngPixels = std::uint64_t(1) << 26;
 inline constexpr std::size_t kMaxPngChunkBytes = std::size_t(1) << 26;
 
 /// Reads a PNG of any colour type and bit depth as 8-bit RGB (grey expanded, palette looked
-/// up, alpha dropped, 16-bit samples reduced to their high byte). Throws InputError naming
+/// up, 16-bit samples reduced to their high byte); an alpha channel (colour types 4 and 6) is
+/// kept in Image::alpha, not composited (tRNS is dropped). Throws InputError naming
 /// the file and the problem, also for files over the limits above or not regular files.
 Image read_png(const std::filesystem::path& path);
 

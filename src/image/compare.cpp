@@ -49,8 +49,9 @@ std::string size_text(const Image& image) {
 // would otherwise be read out of bounds).
 void check_comparable(const Image& a, const Image& b) {
   for (const Image* image : {&a, &b}) {
-    if (image->width < 0 || image->height < 0 ||
-        image->rgb.size() != std::size_t(image->width) * std::size_t(image->height) * 3) {
+    const std::size_t pixels = std::size_t(image->width) * std::size_t(image->height);
+    if (image->width < 0 || image->height < 0 || image->rgb.size() != pixels * 3 ||
+        (!image->alpha.empty() && image->alpha.size() != pixels)) {
       throw InputError("image buffer of " + std::to_string(image->rgb.size()) +
                        " bytes does not match its size " + size_text(*image));
     }
@@ -60,12 +61,21 @@ void check_comparable(const Image& a, const Image& b) {
   }
 }
 
-// Largest channel difference of pixel index `pixel`, in 8-bit units.
+// A pixel's alpha: 255 (opaque) for an image without an alpha plane.
+int alpha_at(const Image& image, std::size_t pixel) {
+  return image.alpha.empty() ? 255 : int(image.alpha[pixel]);
+}
+
+// Largest channel difference of pixel index `pixel`, in 8-bit units; alpha counts as a fourth
+// channel when either image has it.
 int max_channel_diff(const Image& a, const Image& b, std::size_t pixel) {
   int max_diff = 0;
   for (std::size_t channel = 0; channel < 3; ++channel) {
     const std::size_t i = pixel * 3 + channel;
     max_diff = std::max(max_diff, std::abs(int(a.rgb[i]) - int(b.rgb[i])));
+  }
+  if (!a.alpha.empty() || !b.alpha.empty()) {
+    max_diff = std::max(max_diff, std::abs(alpha_at(a, pixel) - alpha_at(b, pixel)));
   }
   return max_diff;
 }
@@ -86,12 +96,18 @@ CompareResult compare_images(const Image& a, const Image& b) {
   result.height = a.height;
   const std::size_t pixel_count = std::size_t(a.width) * std::size_t(a.height);
 
-  // Sum of squared linear-light differences, in row-major then channel order.
+  // Sum of squared linear-light differences, in row-major then channel order; alpha (linear
+  // already) is a fourth channel when either image has it.
+  const bool with_alpha = !a.alpha.empty() || !b.alpha.empty();
   double sum_squared = 0;
   for (std::size_t pixel = 0; pixel < pixel_count; ++pixel) {
     for (std::size_t channel = 0; channel < 3; ++channel) {
       const std::size_t i = pixel * 3 + channel;
       const double diff = linear[a.rgb[i]] - linear[b.rgb[i]];
+      sum_squared += diff * diff;
+    }
+    if (with_alpha) {
+      const double diff = (alpha_at(a, pixel) - alpha_at(b, pixel)) / 255.0;
       sum_squared += diff * diff;
     }
     const int max_diff = max_channel_diff(a, b, pixel);
@@ -102,7 +118,7 @@ CompareResult compare_images(const Image& a, const Image& b) {
   }
 
   if (pixel_count > 0) {
-    result.rmse_linear = std::sqrt(sum_squared / double(pixel_count * 3));
+    result.rmse_linear = std::sqrt(sum_squared / double(pixel_count * (with_alpha ? 4 : 3)));
     result.share_over_1 = double(result.pixels_over_1) / double(pixel_count);
     result.share_over_8 = double(result.pixels_over_8) / double(pixel_count);
   }

@@ -382,19 +382,33 @@ Image read_png(const std::filesystem::path& path) {
     return fail(std::to_string(ihdr.width) + "x" + std::to_string(ihdr.height) +
                 " is more than the " + std::to_string(kMaxPngPixels) + " pixels covrast reads");
   }
-  // Any colour type and bit depth to 8-bit RGB: grey expanded, palette looked up, alpha and
-  // tRNS dropped (not composited), 16-bit samples reduced to their high byte.
+  // Any colour type and bit depth to 8-bit RGB: grey expanded, palette looked up, 16-bit
+  // samples reduced to their high byte. An alpha channel (colour types 4 and 6, as covrast
+  // writes a transparent background) is kept in Image::alpha, not composited; tRNS is dropped.
+  const bool has_alpha = ihdr.color_type == SPNG_COLOR_TYPE_GRAYSCALE_ALPHA ||
+                         ihdr.color_type == SPNG_COLOR_TYPE_TRUECOLOR_ALPHA;
+  const int format = has_alpha ? SPNG_FMT_RGBA8 : SPNG_FMT_RGB8;
   std::size_t size = 0;
-  if (const int error = spng_decoded_image_size(ctx, SPNG_FMT_RGB8, &size); error != 0) {
+  if (const int error = spng_decoded_image_size(ctx, format, &size); error != 0) {
     return fail(reason(error));
   }
   Image image;
   image.width = int(ihdr.width);
   image.height = int(ihdr.height);
-  image.rgb.resize(size);
-  if (const int error = spng_decode_image(ctx, image.rgb.data(), size, SPNG_FMT_RGB8, 0);
-      error != 0) {
+  std::vector<std::uint8_t> decoded(size);
+  if (const int error = spng_decode_image(ctx, decoded.data(), size, format, 0); error != 0) {
     return fail(reason(error));
+  }
+  if (has_alpha) {
+    const std::size_t pixels = size / 4;
+    image.rgb.resize(pixels * 3);
+    image.alpha.resize(pixels);
+    for (std::size_t i = 0; i < pixels; ++i) {
+      std::copy_n(&decoded[4 * i], 3, &image.rgb[3 * i]);
+      image.alpha[i] = decoded[4 * i + 3];
+    }
+  } else {
+    image.rgb = std::move(decoded);
   }
   // The last IDAT chunk's CRC is checked only when libspng reads on (decode_png_rgba).
   if (const int error = spng_decode_chunks(ctx); error != 0) return fail(reason(error));
