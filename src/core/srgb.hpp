@@ -4,7 +4,9 @@
 // built from these, so that they agree bit for bit.
 #pragma once
 
+#include <array>
 #include <cmath>
+#include <cstddef>
 
 namespace covrast::detail {
 
@@ -20,6 +22,17 @@ inline double srgb_decode(double c) {
 ///   1.055 l ^ (1 / 2.4) - 0.055    otherwise
 inline double srgb_encode(double l) {
   return l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055;
+}
+
+/// srgb_decode(c / 255) of every 8-bit code c, computed once per process (thread-safe): what
+/// an 8-bit sRGB byte means in linear light, for everything that reads one back.
+inline const std::array<double, 256>& srgb8_decode_table() {
+  static const std::array<double, 256> table = [] {
+    std::array<double, 256> t{};
+    for (int code = 0; code < 256; ++code) t[std::size_t(code)] = srgb_decode(code / 255.0);
+    return t;
+  }();
+  return table;
 }
 
 }  // namespace covrast::detail

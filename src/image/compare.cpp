@@ -25,22 +25,6 @@ constexpr int kHeatmapSaturationSrgb8 = 32;
 // The ramp black -> blue -> green -> yellow -> red has four equal segments.
 constexpr int kHeatmapSegmentSrgb8 = kHeatmapSaturationSrgb8 / 4;
 
-// IEC 61966-2-1 sRGB decoding (core/srgb.hpp) of c = code / 255, computed once in double for
-// all 256 codes.
-std::array<double, 256> make_srgb8_to_linear_table() {
-  std::array<double, 256> table{};
-  for (int code = 0; code < 256; ++code) {
-    const double c = code / 255.0;
-    table[std::size_t(code)] = detail::srgb_decode(c);
-  }
-  return table;
-}
-
-const std::array<double, 256>& srgb8_to_linear() {
-  static const std::array<double, 256> kTable = make_srgb8_to_linear_table();
-  return kTable;
-}
-
 std::string size_text(const Image& image) {
   return std::to_string(image.width) + "x" + std::to_string(image.height);
 }
@@ -89,7 +73,7 @@ std::uint8_t ramp_up(int t) {
 
 CompareResult compare_images(const Image& a, const Image& b) {
   check_comparable(a, b);
-  const std::array<double, 256>& linear = srgb8_to_linear();
+  const std::array<double, 256>& linear = detail::srgb8_decode_table();
 
   CompareResult result;
   result.width = a.width;

@@ -222,8 +222,9 @@ EnvironmentMap decode_exr(const std::uint8_t* bytes, std::size_t size, const std
 EnvironmentMap decode_ldr(const std::uint8_t* bytes, std::size_t size, const std::string& name) {
   const RgbaImage image = decode_image(bytes, size, name);
   check_size(name, image.width, image.height);
+  const std::array<double, 256>& decoded = detail::srgb8_decode_table();
   float linear[256];
-  for (int c = 0; c < 256; ++c) linear[c] = float(detail::srgb_decode(c / 255.0));
+  for (int c = 0; c < 256; ++c) linear[c] = float(decoded[std::size_t(c)]);
   EnvironmentMap map;
   map.width = image.width;
   map.height = image.height;

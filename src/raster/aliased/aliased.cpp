@@ -38,7 +38,7 @@ std::uint64_t flat_owner(const std::uint8_t code[3]) {
 
 /// The linear value of an 8-bit sRGB code (IEC 61966-2-1): encode_srgb8 of it gives the code
 /// back, so a pixel that no BLEND triangle covers keeps its bytes.
-double decode_srgb8(std::uint8_t code) { return srgb_decode(code / 255.0); }
+double decode_srgb8(std::uint8_t code) { return srgb8_decode_table()[code]; }
 
 void write_codes(std::uint64_t owner, std::uint8_t* dst) {
   dst[0] = std::uint8_t(owner >> 8);
