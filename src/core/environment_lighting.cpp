@@ -249,14 +249,17 @@ std::vector<EnvironmentSun> take_out_suns(std::vector<glm::vec3>& texels, int w,
 
 }  // namespace
 
-glm::dvec3 environment_radiance(const EnvironmentLight& light, const glm::dvec3& d_world) {
-  // The map turned by R_y(rotation) into the world: look up R_y(-rotation) d.
-  const double rotation = light.rotation_deg * (kPi / 180.0);
-  const double c = std::cos(rotation), s = std::sin(rotation);
-  const glm::dvec3 d_map(d_world.x * c - d_world.z * s, d_world.y, d_world.x * s + d_world.z * c);
-  const EnvironmentMap& map = *light.map;
-  return equirect_bilinear(map.radiance_linear, map.width, map.height, environment_uv(d_map)) *
-         light.intensity;
+EnvironmentSky::EnvironmentSky(const EnvironmentLight& light)
+    : map_(light.map.get()),
+      cos_rotation_(std::cos(light.rotation_deg * (kPi / 180.0))),
+      sin_rotation_(std::sin(light.rotation_deg * (kPi / 180.0))),
+      intensity_(light.intensity) {}
+
+glm::dvec3 EnvironmentSky::radiance(const glm::dvec3& d_world) const {
+  const glm::dvec3 d_map = turn_about_y(d_world, cos_rotation_, -sin_rotation_);
+  return equirect_bilinear(map_->radiance_linear, map_->width, map_->height,
+                           environment_uv(d_map)) *
+         intensity_;
 }
 
 std::array<double, 3> uniform_environment_integrals(double mu, double roughness) {
@@ -395,15 +398,11 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
 }
 
 glm::dvec3 EnvironmentLighting::to_world(const glm::dvec3& d) const {
-  // R_y(r): the map turned into the world.
-  return {d.x * cos_rotation_ + d.z * sin_rotation_, d.y,
-          -d.x * sin_rotation_ + d.z * cos_rotation_};
+  return turn_about_y(d, cos_rotation_, sin_rotation_);
 }
 
 glm::dvec3 EnvironmentLighting::to_map(const glm::dvec3& d) const {
-  // The inverse rotation R_y(-r): the map was turned by R_y(r) into the world.
-  return {d.x * cos_rotation_ - d.z * sin_rotation_, d.y,
-          d.x * sin_rotation_ + d.z * cos_rotation_};
+  return turn_about_y(d, cos_rotation_, -sin_rotation_);
 }
 
 glm::dvec3 EnvironmentLighting::irradiance(const glm::dvec3& n_world) const {

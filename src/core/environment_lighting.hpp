@@ -117,9 +117,26 @@ class EnvironmentLighting {
   double intensity_ = 1.0;
 };
 
-/// The radiance of `light` arriving from unit world direction d (turned and scaled as the
-/// light says), bilinear in its map with the suns left in: what a skybox shows.
-glm::dvec3 environment_radiance(const EnvironmentLight& light, const glm::dvec3& d_world);
+/// R_y(a) d, given cos a and sin a: a map turned by a about +Y into the world is
+/// turn_about_y(d, cos a, sin a), and a world direction in the map is turn_about_y(d, cos a,
+/// -sin a).
+inline glm::dvec3 turn_about_y(const glm::dvec3& d, double cos_a, double sin_a) {
+  return {d.x * cos_a + d.z * sin_a, d.y, -d.x * sin_a + d.z * cos_a};
+}
+
+/// What a skybox shows: the radiance of a light's map arriving from a unit world direction
+/// (turned and scaled as the light says), bilinear in the map with its suns left in. The
+/// light's map must outlive it.
+class EnvironmentSky {
+ public:
+  explicit EnvironmentSky(const EnvironmentLight& light);
+  glm::dvec3 radiance(const glm::dvec3& d_world) const;
+
+ private:
+  const EnvironmentMap* map_;
+  double cos_rotation_ = 1.0, sin_rotation_ = 0.0;
+  double intensity_ = 1.0;
+};
 
 /// Uniform-light values (L = 1) of E_s, A and B for n . v = mu and perceptual roughness r:
 /// {int s (n.l)+ dl / pi, int D V (n.l)+ dl, int s D V (n.l)+ dl}.

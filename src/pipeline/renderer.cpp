@@ -10,10 +10,8 @@
 // sequence, tiles of a fixed grid), and each task writes only its own output, so the image
 // is the same for every thread count.
 #include "binning/tile_bins.hpp"
-#include "core/environment_lighting.hpp"
 #include "core/fork_join.hpp"
 #include "core/tile_raster.hpp"
-#include "core/tone_map.hpp"
 #include "geometry/frontend.hpp"
 #include "post/background.hpp"
 #include "post/fxaa.hpp"
@@ -91,27 +89,6 @@ void post_process_fxaa(const FxaaOptions& options, Image& input, detail::LumaPla
   detail::fork_join_for(rows, [&](const tbb::blocked_range<int>& r) {
     detail::fxaa_rows(input, luma, options, frame, r.begin(), r.end(), kernels);
   });
-}
-
-/// The skybox behind pixel (x, y): the environment's radiance along the ray through the
-/// pixel's centre (orthographic: along the view direction), exposed and tone-mapped as the
-/// shaded colours are.
-glm::dvec3 sky_at(const Scene& scene, int width_px, int height_px, int x, int y) {
-  const Camera& cam = scene.camera;
-  const glm::dvec3 forward = glm::normalize(cam.target - cam.eye);
-  glm::dvec3 d = forward;
-  if (!cam.orthographic) {
-    const glm::dvec3 right = glm::normalize(glm::cross(forward, cam.up));
-    const glm::dvec3 up = glm::cross(right, forward);
-    const double half_h = std::tan(0.5 * cam.fovy_deg * (3.14159265358979323846 / 180.0));
-    const double half_w = half_h * double(width_px) / double(height_px);
-    const double ndc_x = 2.0 * (x + 0.5) / width_px - 1.0;
-    const double ndc_y = 1.0 - 2.0 * (y + 0.5) / height_px;
-    d = glm::normalize(forward + right * (ndc_x * half_w) + up * (ndc_y * half_h));
-  }
-  const detail::ToneMapping mapping{detail::ToneMapOperator(int(scene.tone_map)), scene.exposure};
-  const glm::dvec3 radiance = detail::environment_radiance(*scene.environment, d);
-  return mapping.is_identity() ? radiance : detail::tone_map(mapping, radiance);
 }
 
 }  // namespace
@@ -359,14 +336,10 @@ RenderResult Renderer::render_frame() {
       if (keyed) post_process_fxaa(im.options.fxaa, im.post_input, im.post_luma, over_white);
     }
     if (im.scene.background_kind == BackgroundKind::Transparent) {
-      const Image over_black = result.color;
-      detail::key_transparent(over_black, over_white, result.color);
+      detail::key_transparent(result.color, over_white);
     } else if (im.scene.background_kind == BackgroundKind::Skybox) {
-      const Image over_black = result.color;
-      detail::key_skybox(
-          over_black, over_white,
-          [&](int x, int y) { return sky_at(im.scene, im.width_px, im.height_px, x, y); },
-          result.color);
+      detail::key_skybox(result.color, over_white,
+                         detail::SkyView(im.scene, im.width_px, im.height_px));
     }
     t4 = Clock::now();
   });

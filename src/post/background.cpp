@@ -9,19 +9,10 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <numbers>
 
 namespace covrast::detail {
 namespace {
-
-/// The linear value of each 8-bit code (the encoder's inverse at the code itself).
-const std::array<double, 256>& decode_table() {
-  static const std::array<double, 256> table = [] {
-    std::array<double, 256> t{};
-    for (int c = 0; c < 256; ++c) t[std::size_t(c)] = srgb_decode(c / 255.0);
-    return t;
-  }();
-  return table;
-}
 
 /// The background's share w of one pixel from its codes over black and over white.
 double background_share(const std::uint8_t* black, const std::uint8_t* white) {
@@ -30,7 +21,7 @@ double background_share(const std::uint8_t* black, const std::uint8_t* white) {
       white[2] == 255) {
     return 1.0;
   }
-  const std::array<double, 256>& dec = decode_table();
+  const std::array<double, 256>& dec = srgb8_decode_table();
   double sum = 0.0;
   for (int c = 0; c < 3; ++c) sum += dec[white[c]] - dec[black[c]];
   return std::clamp(sum / 3.0, 0.0, 1.0);
@@ -42,43 +33,56 @@ std::uint8_t unit_code(double x) {
 
 }  // namespace
 
-void key_transparent(const Image& over_black, const Image& over_white, Image& out) {
-  const std::array<double, 256>& dec = decode_table();
-  out.width = over_black.width;
-  out.height = over_black.height;
-  out.rgb.assign(over_black.rgb.size(), 0);
-  out.alpha.assign(std::size_t(out.width) * std::size_t(out.height), 0);
-  for (std::size_t i = 0; i < out.alpha.size(); ++i) {
-    const std::uint8_t* black = &over_black.rgb[3 * i];
-    const double alpha = 1.0 - background_share(black, &over_white.rgb[3 * i]);
-    out.alpha[i] = unit_code(alpha);
-    if (out.alpha[i] == 0) continue;  // colour 0 where nothing shows
-    for (int c = 0; c < 3; ++c) {
-      out.rgb[3 * i + std::size_t(c)] =
-          alpha >= 1.0 ? black[c] : encode_srgb8(float(std::min(1.0, dec[black[c]] / alpha)));
+SkyView::SkyView(const Scene& scene, int width_px, int height_px)
+    : sky_(*scene.environment),
+      mapping_{ToneMapOperator(int(scene.tone_map)), scene.exposure},
+      orthographic_(scene.camera.orthographic),
+      forward_(glm::normalize(scene.camera.target - scene.camera.eye)),
+      right_(glm::normalize(glm::cross(forward_, scene.camera.up))),
+      up_(glm::cross(right_, forward_)),
+      width_px_(width_px),
+      height_px_(height_px) {
+  half_h_ = std::tan(0.5 * scene.camera.fovy_deg * (std::numbers::pi / 180.0));
+  half_w_ = half_h_ * double(width_px) / double(height_px);
+}
+
+glm::dvec3 SkyView::at(int x, int y) const {
+  glm::dvec3 d = forward_;
+  if (!orthographic_) {
+    const double ndc_x = 2.0 * (x + 0.5) / width_px_ - 1.0;
+    const double ndc_y = 1.0 - 2.0 * (y + 0.5) / height_px_;
+    d = glm::normalize(forward_ + right_ * (ndc_x * half_w_) + up_ * (ndc_y * half_h_));
+  }
+  const glm::dvec3 radiance = sky_.radiance(d);
+  return mapping_.is_identity() ? radiance : tone_map(mapping_, radiance);
+}
+
+void key_transparent(Image& frame, const Image& over_white) {
+  const std::array<double, 256>& dec = srgb8_decode_table();
+  frame.alpha.assign(std::size_t(frame.width) * std::size_t(frame.height), 0);
+  for (std::size_t i = 0; i < frame.alpha.size(); ++i) {
+    std::uint8_t* rgb = &frame.rgb[3 * i];  // over black in, the keyed colour out
+    const double alpha = 1.0 - background_share(rgb, &over_white.rgb[3 * i]);
+    frame.alpha[i] = unit_code(alpha);
+    if (frame.alpha[i] == 0) {
+      std::fill(rgb, rgb + 3, std::uint8_t(0));  // colour 0 where nothing shows
+    } else if (alpha < 1.0) {
+      for (int c = 0; c < 3; ++c) rgb[c] = encode_srgb8(float(std::min(1.0, dec[rgb[c]] / alpha)));
     }
   }
 }
 
-void key_skybox(const Image& over_black, const Image& over_white,
-                const std::function<glm::dvec3(int, int)>& sky, Image& out) {
-  const std::array<double, 256>& dec = decode_table();
-  out.width = over_black.width;
-  out.height = over_black.height;
-  out.rgb.assign(over_black.rgb.size(), 0);
-  out.alpha.clear();
-  for (int y = 0; y < out.height; ++y) {
-    for (int x = 0; x < out.width; ++x) {
-      const std::size_t i = std::size_t(y) * std::size_t(out.width) + std::size_t(x);
-      const std::uint8_t* black = &over_black.rgb[3 * i];
-      const double w = background_share(black, &over_white.rgb[3 * i]);
-      std::uint8_t* dst = &out.rgb[3 * i];
-      if (w == 0.0) {
-        std::copy(black, black + 3, dst);
-        continue;
-      }
-      const glm::dvec3 k = sky(x, y);
-      for (int c = 0; c < 3; ++c) dst[c] = encode_srgb8(float(dec[black[c]] + w * k[c]));
+void key_skybox(Image& frame, const Image& over_white, const SkyView& sky) {
+  const std::array<double, 256>& dec = srgb8_decode_table();
+  frame.alpha.clear();
+  for (int y = 0; y < frame.height; ++y) {
+    for (int x = 0; x < frame.width; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
+      std::uint8_t* rgb = &frame.rgb[3 * i];  // over black in, composited out
+      const double w = background_share(rgb, &over_white.rgb[3 * i]);
+      if (w == 0.0) continue;
+      const glm::dvec3 k = sky.at(x, y);
+      for (int c = 0; c < 3; ++c) rgb[c] = encode_srgb8(float(dec[rgb[c]] + w * k[c]));
     }
   }
 }

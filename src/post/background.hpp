@@ -17,20 +17,39 @@
 #pragma once
 
 #include <covrast/image.hpp>
+#include <covrast/scene.hpp>
+
+#include "core/environment_lighting.hpp"
+#include "core/tone_map.hpp"
 
 #include <glm/glm.hpp>
 
-#include <functional>
-
 namespace covrast::detail {
 
-/// `over_black` and `over_white` (same size): the frame over B = 0 and B = 1. Writes into
-/// `out` (resized) the RGB colours not premultiplied and the alpha plane.
-void key_transparent(const Image& over_black, const Image& over_white, Image& out);
+/// The skybox as the scene's camera sees it: the environment's radiance along the ray through a
+/// pixel's centre (orthographic: along the view direction), exposed and tone-mapped as the
+/// shaded colours are. The camera's frame, the map's rotation and the tone map are set up once
+/// per frame, not per pixel. `scene.environment` must be set.
+class SkyView {
+ public:
+  SkyView(const Scene& scene, int width_px, int height_px);
+  glm::dvec3 at(int x, int y) const;
 
-/// As key_transparent, but composites `sky(x, y)` (linear, display-ready: tone-mapped) where
-/// the background shows; `out` has no alpha plane.
-void key_skybox(const Image& over_black, const Image& over_white,
-                const std::function<glm::dvec3(int, int)>& sky, Image& out);
+ private:
+  EnvironmentSky sky_;
+  ToneMapping mapping_;
+  bool orthographic_;
+  glm::dvec3 forward_, right_, up_;
+  double half_w_ = 0.0, half_h_ = 0.0;  ///< tan of the half field of view, across and down
+  int width_px_, height_px_;
+};
+
+/// `frame` holds the frame over B = 0 and `over_white` (same size) the frame over B = 1.
+/// Rewrites `frame` in place: the RGB colours not premultiplied, and the alpha plane.
+void key_transparent(Image& frame, const Image& over_white);
+
+/// As key_transparent, but composites the sky (display-ready: tone-mapped) where the
+/// background shows; `frame` keeps no alpha plane.
+void key_skybox(Image& frame, const Image& over_white, const SkyView& sky);
 
 }  // namespace covrast::detail
