@@ -127,7 +127,7 @@ std::size_t morph_target_count(const tinygltf::Model& model, const tinygltf::Nod
 }
 
 int select_animation(const tinygltf::Model& model, const std::string& name,
-                     const GltfPoseRequest& request) {
+                     const AnimationTime& request) {
   const int count = int(model.animations.size());
   if (request.index >= 0) {
     if (request.index >= count) {
@@ -150,7 +150,7 @@ int select_animation(const tinygltf::Model& model, const std::string& name,
 
 }  // namespace
 
-void pose_at_time(tinygltf::Model& model, const std::string& name, const GltfPoseRequest& request,
+void pose_at_time(tinygltf::Model& model, const std::string& name, const AnimationTime& request,
                   std::vector<std::string>& warnings) {
   if (!std::isfinite(request.time_s) || request.time_s < 0.0) {
     fail(name, "animation time must be a finite number of seconds >= 0");

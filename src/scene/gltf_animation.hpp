@@ -4,6 +4,8 @@
 // by their joints and applies the weights, exactly as for the static pose.
 #pragma once
 
+#include <covrast/scene.hpp>
+
 #include <tiny_gltf.h>
 
 #include <string>
@@ -11,22 +13,15 @@
 
 namespace covrast::detail {
 
-/// Which animation and when: `index` >= 0 selects by index, else a non-empty `name` by name,
-/// else the file's first animation; `time_s` in seconds, finite and >= 0.
-struct GltfPoseRequest {
-  int index = -1;
-  std::string name;
-  double time_s = 0.0;
-};
-
-/// Samples the requested animation at its time into `model`'s nodes. Times before the first
+/// Samples the requested animation (AnimationTime: by index, else by name, else the first) at
+/// its time into `model`'s nodes. Times before the first
 /// keyframe take the first value, after the last the last. Interpolation: STEP (the value of
 /// the keyframe at or before), LINEAR (spherical for rotations, along the shorter arc) and
 /// CUBICSPLINE (the Hermite spline of the specification's Appendix C, with its tangents
 /// scaled by the keyframe interval; rotations normalised). A file without animations gets a
 /// warning in `warnings` and keeps its static pose; an unknown animation, broken samplers or
 /// accessors are errors (InputError naming `name`).
-void pose_at_time(tinygltf::Model& model, const std::string& name, const GltfPoseRequest& request,
+void pose_at_time(tinygltf::Model& model, const std::string& name, const AnimationTime& request,
                   std::vector<std::string>& warnings);
 
 }  // namespace covrast::detail

@@ -995,7 +995,7 @@ class GltfMeshBuilder {
 }  // namespace
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir, const GltfPoseRequest* pose) {
+                      const std::filesystem::path& base_dir, const AnimationTime* pose) {
   std::string warn;
   tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);

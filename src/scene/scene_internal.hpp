@@ -80,13 +80,11 @@ bool json_depth_within(std::string_view text, int limit, std::size_t& offset);
 LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
                      const std::filesystem::path& base_dir);
 
-struct GltfPoseRequest;  // scene/gltf_animation.hpp
-
 /// glTF 2.0, either JSON (.gltf) or binary (.glb, recognised by its magic). External buffers
 /// are resolved against `base_dir`. `pose`: a moment of an animation to pose the file at
 /// (null: the static pose).
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir, const GltfPoseRequest* pose = nullptr);
+                      const std::filesystem::path& base_dir, const AnimationTime* pose = nullptr);
 
 /// An image file as a texture (docs/textures.md): read_image, then make_texture with `srgb`
 /// (true for colour maps: glTF baseColor and emissive, OBJ map_Kd). `name` names it in

@@ -558,7 +558,7 @@ class SceneMeshes {
   /// `pose`: the moment glTF files are posed at (null: their static pose).
   SceneMeshes(const std::string& file, std::filesystem::path base_dir,
               std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files,
-              const detail::GltfPoseRequest* pose)
+              const AnimationTime* pose)
       : file_(file), base_dir_(std::move(base_dir)), files_(files), pose_(pose) {}
 
   /// The mesh that entry `key` names.
@@ -627,7 +627,7 @@ class SceneMeshes {
   const std::string& file_;
   std::filesystem::path base_dir_;
   std::map<std::pair<std::string, MeshFormat>, CachedMesh>& files_;
-  const detail::GltfPoseRequest* pose_;
+  const AnimationTime* pose_;
   std::set<std::pair<std::string, MeshFormat>> warned_;
 };
 
@@ -922,12 +922,12 @@ EnvironmentLight scene_environment(const std::string& file, const json& value,
 
 /// The root's "animation" (an index or a name) and "time" (seconds >= 0): either makes glTF
 /// files posed at that moment; neither, their static pose.
-std::optional<detail::GltfPoseRequest> animation_time(const std::string& file, const json& root,
-                                                      const SceneReader& reader) {
+std::optional<AnimationTime> animation_time(const std::string& file, const json& root,
+                                            const SceneReader& reader) {
   const auto animation = root.find("animation");
   const auto time = root.find("time");
   if (animation == root.end() && time == root.end()) return std::nullopt;
-  detail::GltfPoseRequest pose;
+  AnimationTime pose;
   if (animation != root.end()) {
     if (animation->is_string()) {
       pose.name = animation->get<std::string>();
@@ -1007,7 +1007,7 @@ Scene scene_from_root(const json& root, const std::string& file,
 
   const json& meshes = reader.required(root, "meshes", "meshes");
   if (!meshes.is_array()) fail(file, "meshes", "expected an array, got " + shown(meshes));
-  const std::optional<detail::GltfPoseRequest> pose = animation_time(file, root, reader);
+  const std::optional<AnimationTime> pose = animation_time(file, root, reader);
   SceneMeshes cache(file, base_dir, files, pose ? &*pose : nullptr);
   FirstGltf first_gltf;
   std::uint64_t triangles = 0;
