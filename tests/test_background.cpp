@@ -85,13 +85,7 @@ Scene triangle_scene(BackgroundKind background) {
   return scene;
 }
 
-Image render_mode(const Scene& scene, const std::string& mode, int threads = 2, int tile = 64) {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = threads;
-  options.tile = tile;
-  return covrast::render(scene, options).color;
-}
+using covrast::test::render_mode;
 
 }  // namespace
 

@@ -1,14 +1,26 @@
 // Small meshes and scene helpers shared by the test files (test-only code).
 #pragma once
 
+#include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
 #include <cmath>
 #include <cstdint>
 #include <memory>
 #include <numbers>
+#include <string>
 
 namespace covrast::test {
+
+/// The colour image of `scene` rendered in `mode` ("coverage", "msaa:4", ...).
+inline Image render_mode(const Scene& scene, const std::string& mode, int threads = 2,
+                         int tile = 64) {
+  RenderOptions options;
+  options.mode = parse_render_mode(mode);
+  options.threads = threads;
+  options.tile = tile;
+  return render(scene, options).color;
+}
 
 /// The camera that maps the world plane z = 0 one unit to one pixel: x_px = x + w/2,
 /// y_px = h/2 - y (a 90-degree field of view at distance h/2), on a black background.

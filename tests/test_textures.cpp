@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "test_gltf_files.hpp"
+#include "test_meshes.hpp"
 #include "test_tempdir.hpp"
 
 using Catch::Matchers::Contains;
@@ -82,14 +83,7 @@ covrast::TextureSlot slot_of(std::shared_ptr<const covrast::Texture> texture,
   return slot;
 }
 
-covrast::Image render_mode(const covrast::Scene& scene, const char* mode, int threads = 2,
-                           int tile = 64) {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = threads;
-  options.tile = tile;
-  return covrast::render(scene, options).color;
-}
+using covrast::test::render_mode;
 
 }  // namespace
 
@@ -766,7 +760,8 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
   write_file(dir / "m.gltf", textured_gltf("missing.png"));
   const covrast::Scene missing = covrast::load_mesh_scene(dir / "m.gltf", 16, 16);
   CHECK(missing.meshes[0].mesh->materials[0].base_color_texture.texture == nullptr);
-  INFO(missing.warnings.size() << " warnings, first: " << missing.warnings.front() << "; last: " << missing.warnings.back());
+  INFO(missing.warnings.size() << " warnings, first: " << missing.warnings.front()
+                               << "; last: " << missing.warnings.back());
   REQUIRE(missing.warnings.size() == 1);
   CHECK_THAT(missing.warnings[0],
              Contains("m.gltf: image 0 (missing.png): no such file: its texture slots are drawn "
