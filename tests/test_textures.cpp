@@ -13,6 +13,7 @@
 #include "scene/scene_internal.hpp"
 
 #include <turbojpeg.h>
+#include <webp/encode.h>
 #include <catch2/catch.hpp>
 
 #include <chrono>
@@ -786,7 +787,7 @@ TEST_CASE("textures: bad images are InputErrors naming the image and the model",
   REQUIRE_THROWS_WITH(load("cut.jpg"), Contains("m.gltf: image 0 (cut.jpg)"));
   write_file(dir / "text.png", "not an image at all");
   REQUIRE_THROWS_WITH(load("text.png"),
-                      Contains("image 0 (text.png)") && Contains("neither PNG nor JPEG"));
+                      Contains("image 0 (text.png)") && Contains("neither PNG, JPEG nor WebP"));
   REQUIRE_THROWS_WITH(load("data:image/png;base64," + covrast::test::base64("garbage!")),
                       Contains("m.gltf: image 0"));
   // Issue 28: a wrong CRC on the last IDAT chunk decoded without a word.
@@ -1085,5 +1086,113 @@ TEST_CASE("textures: the base colour texture's alpha multiplies into BLEND and M
       }
       REQUIRE(worst <= 1.0);
     }
+  }
+}
+
+namespace {
+
+std::string webp_lossless(const std::vector<std::uint8_t>& rgba, int width, int height) {
+  std::uint8_t* out = nullptr;
+  const std::size_t size = WebPEncodeLosslessRGBA(rgba.data(), width, height, width * 4, &out);
+  REQUIRE(size > 0);
+  std::string bytes(reinterpret_cast<const char*>(out), size);
+  WebPFree(out);
+  return bytes;
+}
+
+covrast::RgbaImage decode_bytes(const std::string& bytes, const std::string& name = "w") {
+  return covrast::decode_image(reinterpret_cast<const std::uint8_t*>(bytes.data()), bytes.size(),
+                               name);
+}
+
+}  // namespace
+
+TEST_CASE("textures: WebP decoded by content: lossless exactly, lossy closely, bounded",
+          "[textures][webp]") {
+  // Lossless with alpha: every byte back.
+  std::vector<std::uint8_t> rgba = random_rgba(7, 5, 11);
+  for (std::size_t i = 3; i < rgba.size(); i += 4) rgba[i] = std::uint8_t(i * 37);
+  const std::string lossless = webp_lossless(rgba, 7, 5);
+  const covrast::RgbaImage back = decode_bytes(lossless);
+  REQUIRE(back.width == 7);
+  REQUIRE(back.height == 5);
+  CHECK(back.rgba == rgba);
+  // Lossy at quality 100 on a smooth opaque image: within a few levels.
+  std::vector<std::uint8_t> smooth(32 * 16 * 4, 255);
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      smooth[(y * 32 + x) * 4 + 0] = std::uint8_t(x * 8);
+      smooth[(y * 32 + x) * 4 + 1] = std::uint8_t(y * 16);
+      smooth[(y * 32 + x) * 4 + 2] = 100;
+    }
+  }
+  std::uint8_t* out = nullptr;
+  const std::size_t size = WebPEncodeRGBA(smooth.data(), 32, 16, 32 * 4, 100.0f, &out);
+  REQUIRE(size > 0);
+  const std::string lossy(reinterpret_cast<const char*>(out), size);
+  WebPFree(out);
+  const covrast::RgbaImage lossy_back = decode_bytes(lossy);
+  REQUIRE(lossy_back.rgba.size() == smooth.size());
+  int worst = 0;
+  for (std::size_t i = 0; i < smooth.size(); ++i)
+    worst = std::max(worst, std::abs(lossy_back.rgba[i] - smooth[i]));
+  CHECK(worst <= 8);
+  // Truncated data is an error, not a partial image.
+  CHECK_THROWS_WITH(decode_bytes(lossless.substr(0, lossless.size() - 4), "model: image 1"),
+                    Contains("model: image 1: cannot decode image:"));
+  // A header claiming 16384x16384 (the VP8L size fields, 14 bits each, all ones) is refused
+  // from the header, before the 1 GiB of pixels is allocated.
+  std::string huge = lossless;
+  REQUIRE(huge.substr(12, 4) == "VP8L");
+  std::uint32_t fields = 0;
+  for (int k = 0; k < 4; ++k) fields |= std::uint32_t(std::uint8_t(huge[21 + k])) << (8 * k);
+  fields |= (1u << 28) - 1u;
+  for (int k = 0; k < 4; ++k) huge[21 + k] = char((fields >> (8 * k)) & 255u);
+  CHECK_THROWS_WITH(decode_bytes(huge), Contains("16384"));
+}
+
+TEST_CASE("textures: EXT_texture_webp draws its source; the core source is the fallback",
+          "[textures][webp][gltf]") {
+  const std::vector<std::uint8_t> texels = random_rgba(3, 3, 5);
+  const auto build = [&](const nlohmann::json& texture, bool required) {
+    covrast::test::GltfBuilder b;
+    const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 1, 1, 0}, "VEC3");
+    const int png = b.add_view(png_bytes(2, 2, 10));
+    const int webp = b.add_view(webp_lossless(texels, 3, 3));
+    b.single_mesh({{{"attributes", {{"POSITION", pos}}}, {"material", 0}}});
+    b.gltf["materials"] = {{{"emissiveTexture", {{"index", 0}}}}};
+    b.gltf["textures"] = {texture};
+    b.gltf["images"] = {{{"bufferView", png}, {"mimeType", "image/png"}},
+                        {{"bufferView", webp}, {"mimeType", "image/webp"}}};
+    b.gltf["extensionsUsed"] = {"EXT_texture_webp"};
+    if (required) b.gltf["extensionsRequired"] = {"EXT_texture_webp"};
+    return b.glb();
+  };
+  covrast::test::TempDir dir("covrast-webp");
+  const auto emissive = [&](const std::string& glb) {
+    write_file(dir / "w.glb", glb);
+    const covrast::Scene scene = covrast::load_mesh_scene(dir / "w.glb", 16, 16);
+    for (const std::string& warning : scene.warnings) {
+      CHECK(warning.find("EXT_texture_webp") == std::string::npos);  // honoured, no warning
+    }
+    return scene.meshes.at(0).mesh->materials.at(0).emissive_texture.texture;
+  };
+  // With a PNG fallback as the core source: the WebP image is drawn.
+  const auto with_fallback = emissive(
+      build({{"source", 0}, {"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}}, false));
+  REQUIRE(with_fallback->levels[0].width == 3);
+  CHECK(with_fallback->linear(0, 2, 1).g == Approx(srgb_decode(texels[(1 * 3 + 2) * 4 + 1])));
+  // Required, with no core source at all.
+  const auto required =
+      emissive(build({{"extensions", {{"EXT_texture_webp", {{"source", 1}}}}}}, true));
+  CHECK(required->levels[0].height == 3);
+  // A source that is not an image index is an error naming the field.
+  for (const nlohmann::json& bad :
+       {nlohmann::json(2), nlohmann::json(-1), nlohmann::json("1"), nlohmann::json(0.5)}) {
+    write_file(dir / "bad.glb",
+               build({{"extensions", {{"EXT_texture_webp", {{"source", bad}}}}}}, true));
+    CHECK_THROWS_WITH(covrast::load_mesh_scene(dir / "bad.glb", 16, 16),
+                      Contains("EXT_texture_webp.source: expected the index of one of the "
+                               "file's 2 images"));
   }
 }

@@ -73,11 +73,13 @@ struct RgbaImage {
   std::vector<std::uint8_t> rgba;
 };
 
-/// Decodes a PNG (libspng) or JPEG (libturbojpeg) held in memory, recognised by its first
-/// bytes (the PNG signature, or the JPEG start-of-image marker FF D8 FF), never by a file
-/// name. PNG: any colour type and bit depth, tRNS applied as alpha, 16-bit samples reduced
-/// to their high byte. JPEG: baseline or progressive, grey or YCbCr (a CMYK file is refused),
-/// alpha 255; any corrupt-data warning is an error. The limits of read_png (kMaxPngSide,
+/// Decodes a PNG (libspng), JPEG (libturbojpeg) or WebP (libwebp) held in memory, recognised
+/// by its first bytes (the PNG signature, the JPEG start-of-image marker FF D8 FF, or a RIFF
+/// header of form WEBP), never by a file name. PNG: any colour type and bit depth, tRNS
+/// applied as alpha, 16-bit samples reduced to their high byte. JPEG: baseline or
+/// progressive, grey or YCbCr (a CMYK file is refused), alpha 255; any corrupt-data warning
+/// is an error. WebP: lossy or lossless, with or without alpha; an animation is refused. The
+/// limits of read_png (kMaxPngSide,
 /// kMaxPngPixels) are checked from the header before anything is allocated. Throws
 /// InputError("NAME: cannot decode image: why").
 RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& name);

@@ -28,6 +28,7 @@
 
 #include <spng.h>
 #include <turbojpeg.h>
+#include <webp/decode.h>
 
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -551,6 +552,39 @@ RgbaImage decode_jpeg_rgba(const std::uint8_t* bytes, std::size_t size,
   return image;
 }
 
+/// Whether the bytes are a WebP file: a RIFF container of form type WEBP.
+bool is_webp(const std::uint8_t* bytes, std::size_t size) {
+  return size >= 12 && std::memcmp(bytes, "RIFF", 4) == 0 && std::memcmp(bytes + 8, "WEBP", 4) == 0;
+}
+
+/// WebP from memory through libwebp (lossy, lossless, with or without alpha; EXT_texture_webp)
+/// as RGBA8. The size comes from the header (WebPGetFeatures) and is checked against the
+/// limits before the pixels are allocated; an animation is refused (a texture has one image).
+RgbaImage decode_webp_rgba(const std::uint8_t* bytes, std::size_t size,
+                           const std::function<void(const std::string&)>& fail) {
+  WebPBitstreamFeatures features;
+  if (const VP8StatusCode status = WebPGetFeatures(bytes, size, &features);
+      status != VP8_STATUS_OK) {
+    fail("not a valid WebP header (libwebp status " + std::to_string(int(status)) + ")");
+  }
+  if (features.has_animation) fail("animated WebP is not supported");
+  if (features.width <= 0 || features.height <= 0) fail("image is empty");
+  if (const std::string why =
+          over_limits(std::uint64_t(features.width), std::uint64_t(features.height));
+      !why.empty()) {
+    fail(why);
+  }
+  RgbaImage image;
+  image.width = features.width;
+  image.height = features.height;
+  image.rgba.resize(std::size_t(image.width) * std::size_t(image.height) * 4);
+  if (WebPDecodeRGBAInto(bytes, size, image.rgba.data(), image.rgba.size(), image.width * 4) ==
+      nullptr) {
+    fail("corrupt or truncated WebP data");
+  }
+  return image;
+}
+
 }  // namespace
 
 RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& name) {
@@ -564,7 +598,8 @@ RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::s
   if (size >= 3 && bytes[0] == 0xFF && bytes[1] == 0xD8 && bytes[2] == 0xFF) {
     return decode_jpeg_rgba(bytes, size, fail);
   }
-  fail(size == 0 ? "empty" : "neither PNG nor JPEG (by its first bytes)");
+  if (is_webp(bytes, size)) return decode_webp_rgba(bytes, size, fail);
+  fail(size == 0 ? "empty" : "neither PNG, JPEG nor WebP (by its first bytes)");
   return {};
 }
 

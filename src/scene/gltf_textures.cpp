@@ -242,6 +242,26 @@ std::shared_ptr<const Texture> GltfTextures::image_texture(int image_index, bool
   return texture;
 }
 
+int GltfTextures::image_source(const tinygltf::Texture& texture, const std::string& what) const {
+  // EXT_texture_webp: {"source": image index} takes the place of the core source, which is
+  // then the fallback for viewers without WebP (and may be absent when the file requires it).
+  const auto it = texture.extensions.find("EXT_texture_webp");
+  if (it == texture.extensions.end()) return texture.source;
+  const std::string where = what + ": EXT_texture_webp";
+  const tinygltf::Value& webp = it->second;
+  if (!webp.IsObject() || !webp.Has("source")) {
+    fail(reader_.name, where + ": expected an object with \"source\"");
+  }
+  const tinygltf::Value& source = webp.Get("source");
+  const std::optional<int> index =
+      source.IsNumber() ? whole_number(source, 0, int(model_.images.size()) - 1) : std::nullopt;
+  if (!index) {
+    fail(reader_.name, where + ".source: expected the index of one of the file's " +
+                           std::to_string(model_.images.size()) + " images");
+  }
+  return *index;
+}
+
 TextureSlot GltfTextures::slot(int texture_index, int texcoord,
                                const tinygltf::ExtensionMap& extensions, bool srgb,
                                const std::string& what) {
@@ -285,7 +305,7 @@ TextureSlot GltfTextures::slot(int texture_index, int texcoord,
   if (out.texcoord < 0 || out.texcoord >= kMaxTexcoordSets) {
     fail(reader_.name, what + ": texCoord " + std::to_string(out.texcoord) + texcoord_range);
   }
-  out.texture = image_texture(texture.source, srgb, what);
+  out.texture = image_texture(image_source(texture, what), srgb, what);
   return out;
 }
 

@@ -42,6 +42,8 @@ class GltfTextures {
  private:
   TextureSlot slot(int texture_index, int texcoord, const tinygltf::ExtensionMap& extensions,
                    bool srgb, const std::string& what);
+  /// The image a texture draws: EXT_texture_webp's source when it has one, else its core one.
+  int image_source(const tinygltf::Texture& texture, const std::string& what) const;
   std::shared_ptr<const Texture> image_texture(int image_index, bool srgb, const std::string& what);
   RgbaImage decode(const tinygltf::Image& image, const std::string& image_name) const;
   /// What identifies an image's bytes: its buffer view, its file, or else the entry itself.
