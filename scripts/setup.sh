@@ -14,7 +14,7 @@ set -euo pipefail
 build_packages=(
   cmake ninja-build g++ pkg-config
   libglm-dev libtbb-dev libspng-dev libturbojpeg0-dev libstb-dev catch2 libbenchmark-dev libhwy-dev
-  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev libdraco-dev libopenexr-dev libwebp-dev
+  nlohmann-json3-dev libtinyobjloader-dev libtinygltf-dev libcli11-dev libdraco-dev libopenexr-dev libwebp-dev libmeshoptimizer-dev
 )
 # What the whole test suite needs besides: clang for the second-compiler check, python3 for
 # the scene and report scripts, chromium to load covrast test's HTML report headless.
@@ -31,6 +31,7 @@ aarch64_packages=(
   g++-aarch64-linux-gnu qemu-user-static file
   libtbb-dev:arm64 libhwy-dev:arm64 libspng-dev:arm64 libstb-dev:arm64 libdraco-dev:arm64
   libtinyobjloader-dev:arm64 libtinygltf-dev:arm64 libturbojpeg0-dev:arm64 libwebp-dev:arm64
+  libmeshoptimizer-dev:arm64
 )
 
 # Usage: scripts/setup.sh [--list] [--build-only | --aarch64]

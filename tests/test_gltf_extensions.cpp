@@ -42,6 +42,8 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
   CHECK(covrast::gltf_extension_support("KHR_materials_clearcoat").support ==
         GltfExtensionSupport::Ignored);
   CHECK(covrast::gltf_extension_support("EXT_meshopt_compression").support ==
+        GltfExtensionSupport::Honoured);
+  CHECK(covrast::gltf_extension_support("KHR_texture_basisu").support ==
         GltfExtensionSupport::Unreadable);
   CHECK(covrast::gltf_extension_support("EXT_made_up").effect.find("unknown") != std::string::npos);
 
@@ -69,7 +71,7 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
   CHECK(unlit.gltf_extensions_used.size() == 3);
   // Required and not readable: refused, naming it.
   std::ofstream(file, std::ios::binary)
-      << triangle_using({"EXT_meshopt_compression"}, {"EXT_meshopt_compression"});
+      << triangle_using({"KHR_texture_basisu"}, {"KHR_texture_basisu"});
   CHECK_THROWS_WITH(covrast::load_mesh_scene(file, 32, 32),
-                    Catch::Contains("requires the glTF extension EXT_meshopt_compression"));
+                    Catch::Contains("requires the glTF extension KHR_texture_basisu"));
 }

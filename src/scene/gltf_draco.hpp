@@ -3,6 +3,8 @@
 // primitive into per-vertex attribute values and triangle corners.
 #pragma once
 
+#include <nlohmann/json_fwd.hpp>
+
 #include <cstddef>
 #include <cstdint>
 #include <map>
@@ -17,10 +19,9 @@ inline constexpr std::string_view kDracoExtension = "KHR_draco_mesh_compression"
 
 /// tinygltf 2.7 without its Draco option refuses a primitive whose "indices" accessor has no
 /// bufferView, which is how a Draco primitive says its indices live in the compressed stream.
-/// For a file (.gltf text or .glb) that names the extension, returns it with "indices" removed
-/// from every Draco primitive (the decoded faces replace them); nullopt for every other file
-/// and for JSON that does not parse (tinygltf then reports the syntax error).
-std::optional<std::string> without_draco_indices(std::string_view bytes);
+/// Removes "indices" from every Draco primitive of the document (the decoded faces replace
+/// them) before tinygltf reads it (gltf_rewrite.hpp); false when none had them.
+bool strip_draco_indices(nlohmann::json& document);
 
 /// One glTF attribute of a decoded primitive: `components` values per vertex.
 struct DracoAttribute {

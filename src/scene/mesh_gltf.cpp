@@ -13,7 +13,9 @@
 #include "scene/gltf_draco.hpp"
 #include "scene/gltf_input.hpp"
 #include "scene/gltf_lights.hpp"
+#include "scene/gltf_meshopt.hpp"
 #include "scene/gltf_pose.hpp"
+#include "scene/gltf_rewrite.hpp"
 #include "scene/gltf_textures.hpp"
 #include "scene/scene_internal.hpp"
 
@@ -201,7 +203,7 @@ std::vector<glm::vec3> world_normals(const std::vector<double>& values, const gl
 tinygltf::Model read_model(std::string_view bytes, const std::string& name,
                            const std::filesystem::path& base_dir, std::string& warn) {
   check_gltf_input(bytes, name, base_dir, warn);
-  const std::optional<std::string> rewritten = without_draco_indices(bytes);
+  const std::optional<std::string> rewritten = rewritten_for_tinygltf(bytes);
   if (rewritten) bytes = *rewritten;
   if (bytes.size() > UINT_MAX) fail(name, "file too large");
   tinygltf::TinyGLTF loader;
@@ -223,10 +225,10 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 8> kImplementedExtensions = {
+constexpr std::array<std::string_view, 9> kImplementedExtensions = {
     kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
     "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform",
-    kLightsExtension,      "EXT_texture_webp"};
+    kLightsExtension,      "EXT_texture_webp",        kMeshoptExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -999,6 +1001,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   std::string warn;
   tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);
+  decode_meshopt_views(model, display_name);  // before anything reads an accessor
   std::vector<std::string> pose_warnings;
   if (pose != nullptr) pose_at_time(model, display_name, *pose, pose_warnings);
   const std::vector<int> roots = root_nodes(model, display_name);
