@@ -40,6 +40,20 @@ double srgb_encode_255(double linear) {
   return 255.0 * (l <= 0.0031308 ? 12.92 * l : 1.055 * std::pow(l, 1.0 / 2.4) - 0.055);
 }
 
+/// A smooth opaque 32x16 image (red along x, green along y, blue 100): what lossy codecs keep
+/// within a few levels.
+std::vector<std::uint8_t> smooth_rgba_32x16() {
+  std::vector<std::uint8_t> rgba(32 * 16 * 4, 255);
+  for (int y = 0; y < 16; ++y) {
+    for (int x = 0; x < 32; ++x) {
+      rgba[(y * 32 + x) * 4 + 0] = std::uint8_t(x * 8);
+      rgba[(y * 32 + x) * 4 + 1] = std::uint8_t(y * 16);
+      rgba[(y * 32 + x) * 4 + 2] = 100;
+    }
+  }
+  return rgba;
+}
+
 /// Deterministic texels: 8-bit RGBA, alpha 255.
 std::vector<std::uint8_t> random_rgba(int width, int height, std::uint32_t seed) {
   std::vector<std::uint8_t> rgba(std::size_t(width) * height * 4);
@@ -631,14 +645,7 @@ TEST_CASE("textures: a progressive JPEG of more than 500 scans is refused (issue
 TEST_CASE("textures: PNG and JPEG decoded by content, from files, data URIs and buffer views",
           "[textures]") {
   // JPEG at quality 100, 4:4:4: a smooth image survives within a few levels.
-  std::vector<std::uint8_t> rgba(32 * 16 * 4, 255);
-  for (int y = 0; y < 16; ++y) {
-    for (int x = 0; x < 32; ++x) {
-      rgba[(y * 32 + x) * 4 + 0] = std::uint8_t(x * 8);
-      rgba[(y * 32 + x) * 4 + 1] = std::uint8_t(y * 16);
-      rgba[(y * 32 + x) * 4 + 2] = 100;
-    }
-  }
+  const std::vector<std::uint8_t> rgba = smooth_rgba_32x16();
   const std::string jpeg = jpeg_bytes(rgba, 32, 16);
   const covrast::RgbaImage decoded =
       covrast::decode_image(reinterpret_cast<const std::uint8_t*>(jpeg.data()), jpeg.size(), "j");
@@ -1118,14 +1125,7 @@ TEST_CASE("textures: WebP decoded by content: lossless exactly, lossy closely, b
   REQUIRE(back.height == 5);
   CHECK(back.rgba == rgba);
   // Lossy at quality 100 on a smooth opaque image: within a few levels.
-  std::vector<std::uint8_t> smooth(32 * 16 * 4, 255);
-  for (int y = 0; y < 16; ++y) {
-    for (int x = 0; x < 32; ++x) {
-      smooth[(y * 32 + x) * 4 + 0] = std::uint8_t(x * 8);
-      smooth[(y * 32 + x) * 4 + 1] = std::uint8_t(y * 16);
-      smooth[(y * 32 + x) * 4 + 2] = 100;
-    }
-  }
+  const std::vector<std::uint8_t> smooth = smooth_rgba_32x16();
   std::uint8_t* out = nullptr;
   const std::size_t size = WebPEncodeRGBA(smooth.data(), 32, 16, 32 * 4, 100.0f, &out);
   REQUIRE(size > 0);
@@ -1151,7 +1151,7 @@ TEST_CASE("textures: WebP decoded by content: lossless exactly, lossy closely, b
   CHECK_THROWS_WITH(decode_bytes(huge), Contains("16384"));
 }
 
-TEST_CASE("textures: EXT_texture_webp draws its source; the core source is the fallback",
+TEST_CASE("textures: EXT_texture_webp draws its source, the core source is the fallback",
           "[textures][webp][gltf]") {
   const std::vector<std::uint8_t> texels = random_rgba(3, 3, 5);
   const auto build = [&](const nlohmann::json& texture, bool required) {

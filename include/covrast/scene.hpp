@@ -161,6 +161,9 @@ struct MeshData {
   /// them (empty: every triangle uses materials[0], or the default material if none).
   std::vector<Material> materials;
   std::vector<std::uint32_t> triangle_materials;
+  /// The file's KHR_materials_variants names (empty: none); a scene's "variant" key or
+  /// SceneChoices::material_variant picks the one drawn (docs/scene-format.md).
+  std::vector<std::string> material_variants;
 
   // Filled by analyze_mesh_topology (load_mesh and load_scene call it); the defaults mean
   // "not known to be closed", which disables back-face culling for the mesh.
@@ -272,9 +275,19 @@ struct AnimationTime {
   double time_s = 0.0;  ///< seconds, finite, >= 0; before the first keyframe the first values
 };
 
+/// What to draw of the glTF files of a scene, in the place of the scene file's keys: a moment
+/// of their animations ("animation" and "time") and a material variant ("variant" of every
+/// glTF mesh: each file must have it).
+struct SceneChoices {
+  std::optional<AnimationTime> pose;
+  std::string material_variant;  ///< KHR_materials_variants name; empty: the scene's own
+};
+
 /// Loads a scene file. Throws InputError with a one-line message naming the file and the
 /// problem (with line and column for malformed JSON).
 Scene load_scene(const std::filesystem::path& json_path);
+/// load_scene with `choices` in the place of the file's keys.
+Scene load_scene(const std::filesystem::path& json_path, const SceneChoices& choices);
 
 /// load_scene with `pose` in the place of the file's "animation" and "time" keys.
 Scene load_scene(const std::filesystem::path& json_path, const AnimationTime& pose);
@@ -310,6 +323,9 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 /// InputError as load_scene.
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width = 640, int height = 360,
                       const std::optional<AnimationTime>& pose = std::nullopt);
+/// load_mesh_scene drawing `choices` (a material variant the file lacks is an InputError).
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
+                      const SceneChoices& choices);
 
 /// The orbit camera of the glTF viewers (model-viewer's camera-orbit, the render-fidelity
 /// harness): target + radius (sin(phi) sin(theta), cos(phi), sin(phi) cos(theta)), angles in

@@ -34,6 +34,7 @@ struct ViewArgs {
   bool skybox = false;           ///< BackgroundKind::Skybox
   std::optional<double> time_s;  ///< --time: pose glTF files at this moment
   std::string animation;         ///< --animation INDEX|NAME
+  std::string variant;           ///< --variant NAME (KHR_materials_variants)
 };
 
 struct RenderArgs {

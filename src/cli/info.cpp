@@ -174,6 +174,9 @@ nlohmann::ordered_json info_json(const InfoArgs& args, const Scene& scene, const
     if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
       m["alpha_materials"] = {{"mask", a.mask}, {"blend", a.blend}};
     }
+    if (!instance.mesh->material_variants.empty()) {
+      m["material_variants"] = instance.mesh->material_variants;
+    }
     meshes.push_back(std::move(m));
   }
   j["meshes"] = std::move(meshes);
@@ -230,6 +233,11 @@ void print_info_text(const InfoArgs& args, const Scene& scene, const Bounds& bou
     }
     if (const AlphaCounts a = alpha_counts(instance); a.mask + a.blend > 0) {
       std::cout << ", alpha materials: " << a.mask << " mask, " << a.blend << " blend";
+    }
+    if (!instance.mesh->material_variants.empty()) {
+      const std::vector<std::string>& variants = instance.mesh->material_variants;
+      std::cout << ", material variants: ";
+      for (std::size_t v = 0; v < variants.size(); ++v) std::cout << (v ? ", " : "") << variants[v];
     }
     std::cout << '\n';
   }

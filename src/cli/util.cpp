@@ -33,7 +33,9 @@ bool is_mesh_file(const std::string& path) {
 }  // namespace
 
 Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int width, int height) {
-  std::optional<AnimationTime> pose;
+  SceneChoices choices;
+  choices.material_variant = view.variant;
+  std::optional<AnimationTime>& pose = choices.pose;
   if (view.time_s || !view.animation.empty()) {
     pose.emplace();
     pose->time_s = view.time_s.value_or(0.0);
@@ -48,8 +50,10 @@ Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int wid
       pose->name = a;
     }
   }
-  if (!is_mesh_file(path)) return pose ? load_scene(path, *pose) : load_scene(path);
-  return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360, pose);
+  if (!is_mesh_file(path)) {
+    return pose || !choices.material_variant.empty() ? load_scene(path, choices) : load_scene(path);
+  }
+  return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360, choices);
 }
 
 void report_scene_warnings(const std::string& what, const std::vector<std::string>& warnings,

@@ -120,6 +120,10 @@ void add_view_options(CLI::App* sub, ViewArgs& args) {
   sub->add_option("--animation", args.animation,
                   "Which animation --time samples: an index or a name (default: the first)")
       ->type_name("INDEX|NAME");
+  sub->add_option("--variant", args.variant,
+                  "Draw every glTF file with this KHR_materials_variants material variant (`info` "
+                  "lists a file's variants; a file without it is an error)")
+      ->type_name("NAME");
   sub->add_flag("--skybox", args.skybox,
                 "Show the environment behind the model, tone-mapped (the frame is rendered twice)")
       ->excludes(transparent);

@@ -17,6 +17,7 @@
 #include "scene/gltf_pose.hpp"
 #include "scene/gltf_rewrite.hpp"
 #include "scene/gltf_textures.hpp"
+#include "scene/gltf_variants.hpp"
 #include "scene/scene_internal.hpp"
 
 #include <stb/stb_image.h>
@@ -225,10 +226,11 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 9> kImplementedExtensions = {
+constexpr std::array<std::string_view, 10> kImplementedExtensions = {
     kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
     "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform",
-    kLightsExtension,      "EXT_texture_webp",        kMeshoptExtension};
+    kLightsExtension,      "EXT_texture_webp",        kMeshoptExtension,
+    kVariantsExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -334,8 +336,9 @@ struct Placement {
 /// colours and one uniform colour (LoadedMesh::has_uniform_color) at the end.
 class GltfMeshBuilder {
  public:
+  /// `variant`: the KHR_materials_variants variant to draw (empty: the default materials).
   GltfMeshBuilder(const tinygltf::Model& model, const std::string& name,
-                  const std::filesystem::path& base_dir)
+                  const std::filesystem::path& base_dir, std::string_view variant)
       : model_(model), name_(name), reader_{model, name}, mesh_(std::make_shared<MeshData>()) {
     mesh_->source = name;
     // The file's materials with their textures (each image decoded once), then glTF's default
@@ -360,6 +363,16 @@ class GltfMeshBuilder {
     }
     mesh_->materials.push_back(convert_material(tinygltf::Material{}));
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
+    mesh_->material_variants = material_variant_names(model, name);
+    if (!variant.empty()) {
+      const auto& names = mesh_->material_variants;
+      const auto it = std::find(names.begin(), names.end(), variant);
+      if (it == names.end()) {
+        fail(name, "no material variant '" + std::string(variant) + "' (" +
+                       material_variants_text(names) + ")");
+      }
+      variant_ = int(it - names.begin());
+    }
     for (const tinygltf::Camera& camera : model.cameras) cameras_.push_back(file_camera(camera));
   }
 
@@ -428,8 +441,27 @@ class GltfMeshBuilder {
         ++undrawn_primitives_[static_cast<std::size_t>(mode)];
         continue;
       }
+      if (const int material = variant_material(primitive, what); material != primitive.material) {
+        // KHR_materials_variants: the variant's material in the place of the primitive's
+        // own, for everything that reads it (colours, alpha, textures).
+        tinygltf::Primitive chosen = primitive;
+        chosen.material = material;
+        add_primitive(chosen, mode, what, placement);
+        continue;
+      }
       add_primitive(primitive, mode, what, placement);
     }
+  }
+
+  /// The material the drawn variant maps `primitive` to (its own without a variant or where
+  /// no mapping names it); the mappings are checked whether a variant is drawn or not.
+  int variant_material(const tinygltf::Primitive& primitive, const std::string& what) const {
+    const std::vector<std::int32_t> mapped = primitive_variant_materials(
+        model_, primitive, mesh_->material_variants.size(), name_, what);
+    if (variant_ < 0 || mapped.empty() || mapped[std::size_t(variant_)] < 0) {
+      return primitive.material;
+    }
+    return mapped[std::size_t(variant_)];
   }
 
   /// One primitive of a triangle mode (TRIANGLES, TRIANGLE_STRIP, TRIANGLE_FAN); `what`
@@ -974,6 +1006,7 @@ class GltfMeshBuilder {
   const std::string& name_;
   const GltfReader reader_;
   std::shared_ptr<MeshData> mesh_;
+  int variant_ = -1;                    ///< the drawn variant's index, or -1
   std::uint32_t default_material_ = 0;  ///< glTF's default material, after the file's
   bool any_normals_ = false;
   std::size_t missing_texcoords_ = 0;  ///< primitives sampling a UV set they lack
@@ -997,7 +1030,8 @@ class GltfMeshBuilder {
 }  // namespace
 
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir, const AnimationTime* pose) {
+                      const std::filesystem::path& base_dir, const AnimationTime* pose,
+                      std::string_view variant) {
   std::string warn;
   tinygltf::Model model = read_model(bytes, display_name, base_dir, warn);
   check_required_extensions(model, display_name);
@@ -1005,7 +1039,7 @@ LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
   std::vector<std::string> pose_warnings;
   if (pose != nullptr) pose_at_time(model, display_name, *pose, pose_warnings);
   const std::vector<int> roots = root_nodes(model, display_name);
-  GltfMeshBuilder builder(model, display_name, base_dir);
+  GltfMeshBuilder builder(model, display_name, base_dir, variant);
   builder.add_node_trees(roots);
   LoadedMesh loaded = builder.finish();
   add_loader_warnings(warn, display_name, loaded.warnings);

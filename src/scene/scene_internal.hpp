@@ -82,9 +82,11 @@ LoadedMesh parse_obj(std::string_view text, const std::string& display_name,
 
 /// glTF 2.0, either JSON (.gltf) or binary (.glb, recognised by its magic). External buffers
 /// are resolved against `base_dir`. `pose`: a moment of an animation to pose the file at
-/// (null: the static pose).
+/// (null: the static pose). `variant`: the KHR_materials_variants variant to draw (empty: the
+/// default materials; a name the file lacks is an InputError listing its variants).
 LoadedMesh parse_gltf(std::string_view bytes, const std::string& display_name,
-                      const std::filesystem::path& base_dir, const AnimationTime* pose = nullptr);
+                      const std::filesystem::path& base_dir, const AnimationTime* pose = nullptr,
+                      std::string_view variant = {});
 
 /// An image file as a texture (docs/textures.md): read_image, then make_texture with `srgb`
 /// (true for colour maps: glTF baseColor and emissive, OBJ map_Kd). `name` names it in

@@ -561,8 +561,9 @@ class SceneMeshes {
               const AnimationTime* pose)
       : file_(file), base_dir_(std::move(base_dir)), files_(files), pose_(pose) {}
 
-  /// The mesh that entry `key` names.
-  CachedMesh& get(const MeshFileRef& ref, const std::string& key, Scene& scene) {
+  /// The mesh that entry `key` names, drawn with material variant `variant` (empty: none).
+  CachedMesh& get(const MeshFileRef& ref, const std::string& key, Scene& scene,
+                  const std::string& variant) {
     const std::filesystem::path full = base_dir_ / std::filesystem::path(ref.relative);
     std::error_code ec;
     const std::filesystem::path canonical = std::filesystem::canonical(full, ec);
@@ -575,11 +576,12 @@ class SceneMeshes {
       moment << '\n' << pose_->index << '\n' << pose_->name << '\n' << pose_->time_s;
       id_path += moment.str();
     }
+    if (!variant.empty()) id_path += "\nvariant " + variant;  // another mesh, too
     const auto id = std::make_pair(id_path, ref.format);
     auto cached = files_.find(id);
     if (cached == files_.end()) {
       CachedMesh loaded_mesh;
-      loaded_mesh.loaded = load(full, ref, key);
+      loaded_mesh.loaded = load(full, ref, key, variant);
       cached = files_.emplace(id, std::move(loaded_mesh)).first;
     }
     if (warned_.insert(id).second) add_warnings(full, cached->second.loaded, scene);
@@ -612,7 +614,7 @@ class SceneMeshes {
   }
 
   detail::LoadedMesh load(const std::filesystem::path& full, const MeshFileRef& ref,
-                          const std::string& key) const {
+                          const std::string& key, const std::string& variant) const {
     std::string bytes;
     std::string error;
     if (!detail::read_whole_file(full, bytes, error)) {
@@ -621,7 +623,7 @@ class SceneMeshes {
     const std::string display = full.lexically_normal().string();
     return ref.format == MeshFormat::Obj
                ? detail::parse_obj(bytes, display, full.parent_path())
-               : detail::parse_gltf(bytes, display, full.parent_path(), pose_);
+               : detail::parse_gltf(bytes, display, full.parent_path(), pose_, variant);
   }
 
   const std::string& file_;
@@ -689,7 +691,17 @@ MeshInstance load_instance(const SceneReader& reader, const std::string& file, c
                            FirstGltf& first_gltf) {
   const json& entry = reader.require_object(value, key);
   const MeshFileRef ref = mesh_file_ref(file, entry, key);
-  CachedMesh& cached = cache.get(ref, key, scene);
+  std::string variant;
+  if (const auto it = entry.find("variant"); it != entry.end()) {
+    if (!it->is_string() || it->get<std::string>().empty()) {
+      fail(file, key + ".variant", "expected a material variant name, got " + shown(*it));
+    }
+    if (ref.format != MeshFormat::Gltf) {
+      fail(file, key + ".variant", "only glTF files have material variants");
+    }
+    variant = it->get<std::string>();
+  }
+  CachedMesh& cached = cache.get(ref, key, scene, variant);
   const detail::LoadedMesh& loaded = cached.loaded;
   // Counted per instance: each instance would have drawn the dropped triangles.
   scene.dropped_nonfinite_triangles += loaded.dropped_nonfinite_triangles;
@@ -946,6 +958,22 @@ std::optional<AnimationTime> animation_time(const std::string& file, const json&
   return pose;
 }
 
+/// The root with `variant` as the "variant" of every glTF mesh entry (SceneChoices).
+void set_material_variant(json& root, const std::string& file, const std::string& variant) {
+  bool any = false;
+  if (const auto meshes = root.find("meshes"); meshes != root.end() && meshes->is_array()) {
+    for (json& entry : *meshes) {
+      if (entry.is_object() && entry.contains("gltf")) {
+        entry["variant"] = variant;
+        any = true;
+      }
+    }
+  }
+  if (!any) {
+    throw InputError(file + ": material variant '" + variant + "': the scene has no glTF meshes");
+  }
+}
+
 /// The root with `pose` in the place of its "animation" and "time" keys.
 void set_animation_time(json& root, const AnimationTime& pose) {
   root.erase("animation");
@@ -1036,13 +1064,16 @@ Scene scene_from_root(const json& root, const std::string& file,
 namespace {
 
 Scene load_scene_posed(const std::filesystem::path& json_path, MeshFiles& files,
-                       const AnimationTime* pose) {
+                       const SceneChoices* choices) {
   // Every JSON access checks its type first; this is the net under them, so that a missed
   // check is still an input error naming the file, not an internal error.
   try {
     const std::string file = json_path.string();
     json root = read_scene_root(json_path, file);
-    if (pose != nullptr) set_animation_time(root, *pose);
+    if (choices != nullptr && choices->pose) set_animation_time(root, *choices->pose);
+    if (choices != nullptr && !choices->material_variant.empty()) {
+      set_material_variant(root, file, choices->material_variant);
+    }
     Scene scene = scene_from_root(root, file, json_path.parent_path(), files, nullptr);
     scene.source = json_path;
     warn_beyond_finite_range(scene);
@@ -1059,12 +1090,22 @@ Scene load_scene(const std::filesystem::path& json_path, MeshFileCache& mesh_fil
 }
 
 Scene load_scene(const std::filesystem::path& json_path, const AnimationTime& pose) {
+  return load_scene(json_path, SceneChoices{pose, {}});
+}
+
+Scene load_scene(const std::filesystem::path& json_path, const SceneChoices& choices) {
   MeshFiles files;
-  return load_scene_posed(json_path, files, &pose);
+  return load_scene_posed(json_path, files, &choices);
 }
 
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
                       const std::optional<AnimationTime>& pose) {
+  return load_mesh_scene(mesh_path, width, height, SceneChoices{pose, {}});
+}
+
+Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
+                      const SceneChoices& choices) {
+  const std::optional<AnimationTime>& pose = choices.pose;
   const std::string file = mesh_path.string();
   std::string ext = mesh_path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -1092,6 +1133,7 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
                {"meshes", json::array({{{gltf ? "gltf" : "obj", mesh_path.filename().string()}}})}};
   if (gltf) root["lights"] = "gltf";
   if (pose) set_animation_time(root, *pose);
+  if (!choices.material_variant.empty()) set_material_variant(root, file, choices.material_variant);
   MeshFiles files;  // the second pass below takes the parsed file from here
   std::vector<detail::FileCamera> cameras;
   Scene scene = scene_from_root(root, file, mesh_path.parent_path(), files, &cameras);
