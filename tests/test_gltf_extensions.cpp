@@ -75,3 +75,22 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
   CHECK_THROWS_WITH(covrast::load_mesh_scene(file, 32, 32),
                     Catch::Contains("requires the glTF extension KHR_texture_basisu"));
 }
+
+TEST_CASE("gltf extensions: a texture whose only image is KHR_texture_basisu is named",
+          "[gltf][extensions]") {
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+  const int uv = b.add_floats({0, 0, 1, 0, 0, 1}, "VEC2");
+  b.single_mesh(nlohmann::json::array(
+      {{{"attributes", {{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"material", 0}}}));
+  b.gltf["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  b.gltf["textures"] = {{{"extensions", {{"KHR_texture_basisu", {{"source", 0}}}}}}};
+  b.gltf["images"] = {{{"uri", "t.ktx2"}}};
+  b.gltf["extensionsUsed"] = {"KHR_texture_basisu"};
+  covrast::test::TempDir dir("covrast-ext");
+  std::ofstream(dir / "b.glb", std::ios::binary) << b.glb();
+  CHECK_THROWS_WITH(covrast::load_mesh_scene(dir / "b.glb", 16, 16),
+                    Catch::Contains("material 0 baseColorTexture: the texture has no image "
+                                    "covrast can read (no \"source\"; only KHR_texture_basisu, "
+                                    "which covrast cannot read)"));
+}

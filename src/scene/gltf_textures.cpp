@@ -246,7 +246,22 @@ int GltfTextures::image_source(const tinygltf::Texture& texture, const std::stri
   // EXT_texture_webp: {"source": image index} takes the place of the core source, which is
   // then the fallback for viewers without WebP (and may be absent when the file requires it).
   const auto it = texture.extensions.find("EXT_texture_webp");
-  if (it == texture.extensions.end()) return texture.source;
+  if (it == texture.extensions.end()) {
+    if (texture.source < 0) {
+      // Only an image format covrast cannot read (KHR_texture_basisu, EXT_texture_avif), and
+      // no core image, which such a file must give unless it requires the extension.
+      std::string formats;
+      for (const auto& [extension, value] : texture.extensions) {
+        formats += (formats.empty() ? "" : ", ") + printable(extension);
+      }
+      fail(reader_.name,
+           what + ": the texture has no image covrast can read (no \"source\"" +
+               (formats.empty() ? std::string()
+                                : "; only " + formats + ", which covrast cannot read") +
+               ")");
+    }
+    return texture.source;
+  }
   const std::string where = what + ": EXT_texture_webp";
   const tinygltf::Value& webp = it->second;
   if (!webp.IsObject() || !webp.Has("source")) {
