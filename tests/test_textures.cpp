@@ -1161,7 +1161,7 @@ TEST_CASE("textures: EXT_texture_webp draws its source, the core source is the f
     const int webp = b.add_view(webp_lossless(texels, 3, 3));
     b.single_mesh({{{"attributes", {{"POSITION", pos}}}, {"material", 0}}});
     b.gltf["materials"] = {{{"emissiveTexture", {{"index", 0}}}}};
-    b.gltf["textures"] = {texture};
+    b.gltf["textures"] = nlohmann::json::array({texture});
     b.gltf["images"] = {{{"bufferView", png}, {"mimeType", "image/png"}},
                         {{"bufferView", webp}, {"mimeType", "image/webp"}}};
     b.gltf["extensionsUsed"] = {"EXT_texture_webp"};
