@@ -79,9 +79,8 @@ struct RgbaImage {
 /// applied as alpha, 16-bit samples reduced to their high byte. JPEG: baseline or
 /// progressive, grey or YCbCr (a CMYK file is refused), alpha 255; any corrupt-data warning
 /// is an error. WebP: lossy or lossless, with or without alpha; an animation is refused. The
-/// limits of read_png (kMaxPngSide,
-/// kMaxPngPixels) are checked from the header before anything is allocated. Throws
-/// InputError("NAME: cannot decode image: why").
+/// limits of read_png (kMaxPngSide, kMaxPngPixels) are checked from the header before
+/// anything is allocated. Throws InputError("NAME: cannot decode image: why").
 RgbaImage decode_image(const std::uint8_t* bytes, std::size_t size, const std::string& name);
 
 /// decode_image of a whole file; refuses what is not a regular file (a FIFO would block).

@@ -50,9 +50,7 @@ Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int wid
       pose->name = a;
     }
   }
-  if (!is_mesh_file(path)) {
-    return pose || !choices.material_variant.empty() ? load_scene(path, choices) : load_scene(path);
-  }
+  if (!is_mesh_file(path)) return load_scene(path, choices);
   return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360, choices);
 }
 

@@ -11,7 +11,6 @@
 #include <draco/core/decoder_buffer.h>
 #include <nlohmann/json.hpp>
 
-#include <cstring>
 #include <memory>
 
 namespace covrast::detail {

@@ -159,7 +159,8 @@ void decode_meshopt_views(tinygltf::Model& model, const std::string& name) {
     model.buffers.push_back(std::move(buffer));
     view.buffer = int(model.buffers.size()) - 1;
     view.byteOffset = 0;
-    // A vertex view keeps the stride it declares; the decoder's stride is the same one.
+    // The view keeps its own byteStride, which the accessors read with (the specification
+    // asks it to equal the extension's; the reader's bounds hold either way).
     view.extensions.erase(it);
   }
 }

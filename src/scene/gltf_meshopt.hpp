@@ -22,9 +22,8 @@ inline constexpr std::uint64_t kMaxMeshoptDecodedBytes = std::uint64_t(1) << 30;
 /// are read only by viewers without the extension); tinygltf 2.7 would read a .glb's binary
 /// chunk into it, or refuse a .gltf buffer without a URI. Each such buffer becomes a data: URI
 /// of one zero byte (tinygltf refuses an empty one) before tinygltf reads the file
-/// (gltf_rewrite.hpp); nothing reads
-/// it, since decode_meshopt_views points every compressed view elsewhere. False when the
-/// document has none.
+/// (gltf_rewrite.hpp); nothing reads it, since decode_meshopt_views points every compressed
+/// view elsewhere. False when the document has none.
 bool empty_meshopt_fallback_buffers(nlohmann::json& document);
 
 /// Decodes every buffer view of `model` that has EXT_meshopt_compression (its "buffer",

@@ -6,8 +6,6 @@
 
 #include <covrast/error.hpp>
 
-#include <climits>
-
 namespace covrast::detail {
 
 std::vector<std::string> material_variant_names(const tinygltf::Model& model,

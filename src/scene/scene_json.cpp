@@ -975,6 +975,14 @@ void set_material_variant(json& root, const std::string& file, const std::string
 }
 
 /// The root with `pose` in the place of its "animation" and "time" keys.
+void set_animation_time(json& root, const AnimationTime& pose);
+
+/// The root with `choices` in the place of its keys (SceneChoices).
+void apply_choices(json& root, const std::string& file, const SceneChoices& choices) {
+  if (choices.pose) set_animation_time(root, *choices.pose);
+  if (!choices.material_variant.empty()) set_material_variant(root, file, choices.material_variant);
+}
+
 void set_animation_time(json& root, const AnimationTime& pose) {
   root.erase("animation");
   if (pose.index >= 0) {
@@ -1070,10 +1078,7 @@ Scene load_scene_posed(const std::filesystem::path& json_path, MeshFiles& files,
   try {
     const std::string file = json_path.string();
     json root = read_scene_root(json_path, file);
-    if (choices != nullptr && choices->pose) set_animation_time(root, *choices->pose);
-    if (choices != nullptr && !choices->material_variant.empty()) {
-      set_material_variant(root, file, choices->material_variant);
-    }
+    if (choices != nullptr) apply_choices(root, file, *choices);
     Scene scene = scene_from_root(root, file, json_path.parent_path(), files, nullptr);
     scene.source = json_path;
     warn_beyond_finite_range(scene);
@@ -1105,7 +1110,6 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
 
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
                       const SceneChoices& choices) {
-  const std::optional<AnimationTime>& pose = choices.pose;
   const std::string file = mesh_path.string();
   std::string ext = mesh_path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
@@ -1132,8 +1136,7 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
                  {"far", 10}}},
                {"meshes", json::array({{{gltf ? "gltf" : "obj", mesh_path.filename().string()}}})}};
   if (gltf) root["lights"] = "gltf";
-  if (pose) set_animation_time(root, *pose);
-  if (!choices.material_variant.empty()) set_material_variant(root, file, choices.material_variant);
+  apply_choices(root, file, choices);
   MeshFiles files;  // the second pass below takes the parsed file from here
   std::vector<detail::FileCamera> cameras;
   Scene scene = scene_from_root(root, file, mesh_path.parent_path(), files, &cameras);

@@ -6,29 +6,32 @@
 
 #include <covrast/image.hpp>
 
+namespace {
+
+/// Aborts (a finding) unless `what` returned sides in 1..kMaxPngSide and `bytes` bytes of
+/// `channels` per pixel.
+void check_image(const char* what, int width, int height, std::size_t bytes, int channels) {
+  if (width < 1 || height < 1 || width > covrast::kMaxPngSide || height > covrast::kMaxPngSide ||
+      bytes != std::size_t(width) * std::size_t(height) * std::size_t(channels)) {
+    std::fprintf(stderr, "covrast fuzz: %s returned a %dx%d image of %zu bytes\n", what, width,
+                 height, bytes);
+    std::abort();
+  }
+}
+
+}  // namespace
+
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   const std::filesystem::path path =
       covrast::fuzz::write_scratch("image.png", covrast::fuzz::as_text(data, size));
   covrast::fuzz::expect_input_error_only([&] {
     const covrast::Image image = covrast::read_png(path);
-    if (image.width < 1 || image.height < 1 || image.width > covrast::kMaxPngSide ||
-        image.height > covrast::kMaxPngSide ||
-        image.rgb.size() != std::size_t(image.width) * std::size_t(image.height) * 3) {
-      std::fprintf(stderr, "covrast fuzz: read_png returned a %dx%d image of %zu bytes\n",
-                   image.width, image.height, image.rgb.size());
-      std::abort();
-    }
+    check_image("read_png", image.width, image.height, image.rgb.size(), 3);
   });
   covrast::fuzz::expect_input_error_only([&] { (void)covrast::read_png_text(path); });
   covrast::fuzz::expect_input_error_only([&] {
     const covrast::RgbaImage image = covrast::decode_image(data, size, "fuzz");
-    if (image.width < 1 || image.height < 1 || image.width > covrast::kMaxPngSide ||
-        image.height > covrast::kMaxPngSide ||
-        image.rgba.size() != std::size_t(image.width) * std::size_t(image.height) * 4) {
-      std::fprintf(stderr, "covrast fuzz: decode_image returned a %dx%d image of %zu bytes\n",
-                   image.width, image.height, image.rgba.size());
-      std::abort();
-    }
+    check_image("decode_image", image.width, image.height, image.rgba.size(), 4);
   });
   return 0;
 }
