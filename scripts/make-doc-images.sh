@@ -24,6 +24,7 @@ for mode in aliased coverage-blend coverage; do
 done
 cp "$tmp/default-coverage.png" "$out/default-coverage.png"
 "$build/covrast" render scenes/lit.json -o "$out/lit.png" --quiet
+"$build/covrast" render docs/scenes/clearcoat.json -o "$out/clearcoat.png" --quiet
 # covrast test's HTML report (docs/ci.md): two cases, one of whose goldens is wrong (an
 # aliased render), as Chromium shows the page. Paths relative to the manifest's folder.
 mkdir -p "$tmp/ci/goldens"

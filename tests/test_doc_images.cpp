@@ -64,4 +64,6 @@ TEST_CASE("docs: the pictures show what this build renders", "[docs]") {
   INFO(kRegenerate);
   CHECK(covrast::read_png(images / "lit.png").rgb ==
         render_scene("scenes/lit.json", "coverage").rgb);
+  CHECK(covrast::read_png(images / "clearcoat.png").rgb ==
+        render_scene("docs/scenes/clearcoat.json", "coverage").rgb);
 }

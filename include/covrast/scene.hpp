@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <memory>
@@ -95,6 +96,27 @@ struct Material {
   TextureSlot normal_texture;
   TextureSlot occlusion_texture;
   TextureSlot emissive_texture;  ///< sRGB texels
+  // The glTF material extensions covrast honours (docs/shading.md, "Material extensions"), for
+  // the pbr model; at these defaults each changes nothing.
+  /// KHR_materials_ior: the dielectric's index of refraction, f0 = ((ior - 1) / (ior + 1))^2;
+  /// 1.5 gives glTF's 0.04. 0 or >= 1 (0 gives f0 = 1, as infinity would).
+  float ior = 1.5f;
+  /// KHR_materials_specular: the dielectric specular's strength (0..1; x the texture's A) and
+  /// its F0 colour (linear, >= 0; x the texture's RGB, sRGB texels):
+  /// dielectric F0 = min(f0(ior) x colour, 1) x strength, F90 = strength.
+  float specular_factor = 1.0f;
+  glm::vec3 specular_color_factor{1.0f};
+  TextureSlot specular_texture;
+  TextureSlot specular_color_texture;  ///< sRGB texels
+  /// KHR_materials_clearcoat: a clear GGX layer (f0 0.04) over the whole material, weighted by
+  /// clearcoat (0..1; x the texture's R) times its Fresnel term at n_c . v; its roughness
+  /// (0..1; x the texture's G) and normal (the clearcoat normal texture, else the surface's
+  /// normal without the normal texture) are its own.
+  float clearcoat = 0.0f;
+  float clearcoat_roughness = 0.0f;
+  TextureSlot clearcoat_texture;
+  TextureSlot clearcoat_roughness_texture;
+  TextureSlot clearcoat_normal_texture;  ///< scale as normal_texture's
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
@@ -103,6 +125,14 @@ struct Material {
   /// The base colour texture's file (OBJ's MTL `map_Kd`, resolved against the .mtl file's
   /// directory); empty if none. The OBJ loader turns it into base_color_texture.
   std::string base_color_texture_path;
+
+  /// Every texture slot, in one order (for checks and listings that treat them alike).
+  std::array<const TextureSlot*, 10> texture_slots() const {
+    return {&base_color_texture,      &metallic_roughness_texture, &normal_texture,
+            &occlusion_texture,       &emissive_texture,           &specular_texture,
+            &specular_color_texture,  &clearcoat_texture,          &clearcoat_roughness_texture,
+            &clearcoat_normal_texture};
+  }
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };

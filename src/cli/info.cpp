@@ -64,8 +64,7 @@ Bounds world_bounds(const Scene& scene) {
 std::size_t texture_count(const MeshInstance& instance) {
   std::set<const Texture*> textures;
   for (const Material& m : instance.materials) {
-    for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                    &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+    for (const TextureSlot* slot : m.texture_slots()) {
       if (slot->texture) textures.insert(slot->texture.get());
     }
   }

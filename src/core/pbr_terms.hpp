@@ -4,8 +4,11 @@
 // operations and get the same bits.
 #pragma once
 
+#include <glm/glm.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace covrast::detail {
 
@@ -25,6 +28,38 @@ inline double schlick_weight(double cos_theta) {
 /// for x = |n . l| or |n . v|.
 inline double smith_g(double n_dot_x, double alpha2) {
   return n_dot_x + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_x * n_dot_x);
+}
+
+/// The GGX specular lobe of the glTF BRDF for unit n, v, l and alpha^2 (Appendix B.3.5):
+/// D x V in one division, alpha^2 / (pi k^2 g_l g_v) with k = (n.h)^2 (alpha^2 - 1) + 1 (0 where
+/// n.h, h.l or h.v <= 0), and h . v for the Fresnel term; h = normalize(l + v), n when l = -v.
+struct GgxLobe {
+  double d_vis = 0.0;
+  double h_dot_v = 0.0;
+};
+inline GgxLobe ggx_lobe(const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l,
+                        double alpha2) {
+  const glm::dvec3 h_sum = l + v;
+  const double h_length = glm::length(h_sum);
+  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
+  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
+  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l);
+  GgxLobe lobe;
+  lobe.h_dot_v = glm::dot(h, v);
+  if (n_dot_h > 0.0 && h_dot_l > 0.0 && lobe.h_dot_v > 0.0) {
+    const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
+    const double gl = smith_g(n_dot_l, alpha2);
+    const double gv = smith_g(n_dot_v, alpha2);
+    lobe.d_vis = alpha2 / (std::numbers::pi * k * k * (gl * gv));
+  }
+  return lobe;
+}
+
+/// KHR_materials_clearcoat's layer weight per unit clearcoat, fresnel_coat with ior 1.5:
+///   Fc = 0.04 + (1 - 0.04) (1 - |n_c . v|)^5.
+inline double clearcoat_fresnel(const glm::dvec3& coat_normal, const glm::dvec3& v) {
+  constexpr double kCoatF0 = 0.04;
+  return kCoatF0 + (1.0 - kCoatF0) * schlick_weight(std::abs(glm::dot(coat_normal, v)));
 }
 
 }  // namespace covrast::detail

@@ -69,26 +69,29 @@ glm::dvec3 environment_diffuse(const ShadingContext& c, double occlusion, const 
   return base * c.environment->irradiance(n) * (occlusion / kPi);
 }
 
-/// The environment's light for the glTF BRDF (core/environment_lighting.hpp):
-///   occlusion x (c_diff (1 - f0) (E / pi - E_s) + f0 A + (1 - f0) B).
-glm::dvec3 environment_pbr(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& n,
+/// The environment's light for the glTF BRDF (core/environment_lighting.hpp), with
+/// F = F0 + (F90 - F0) s:
+///   occlusion x (c_diff ((1 - F0_d) E / pi - (F90 - F0_d) E_s) + F0 A + (F90 - F0) B),
+/// which for F90 = 1 and F0_d = F0 (the core material) is computed as
+///   occlusion x (c_diff (1 - F0) (E / pi - E_s) + F0 A + (1 - F0) B).
+glm::dvec3 environment_pbr(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& n,
                            const glm::dvec3& v) {
   const EnvironmentLighting* environment = s.context->environment;
   if (environment == nullptr || n == glm::dvec3(0.0)) return glm::dvec3(0.0);
-  const EnvironmentIntegrals e = environment->integrals(n, v, s.roughness);
-  const glm::dvec3 c_diff = base * (1.0 - s.metallic);
-  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - s.metallic) + base * s.metallic;
-  const glm::dvec3 one_minus_f0 = glm::dvec3(1.0) - f0;
-  glm::dvec3 sum =
-      s.occlusion * (c_diff * one_minus_f0 * (e.irradiance * (1.0 / kPi) - e.irradiance_schlick) +
-                     f0 * e.specular + one_minus_f0 * e.specular_schlick);
+  const EnvironmentIntegrals e = environment->integrals(n, v, m.roughness);
+  const glm::dvec3 gap = m.f90 - m.f0;
+  const glm::dvec3 diffuse =
+      m.f90 == glm::dvec3(1.0) && m.f0_diffuse == m.f0
+          ? m.c_diff * gap * (e.irradiance * (1.0 / kPi) - e.irradiance_schlick)
+          : m.c_diff * ((glm::dvec3(1.0) - m.f0_diffuse) * (e.irradiance * (1.0 / kPi)) -
+                        (m.f90 - m.f0_diffuse) * e.irradiance_schlick);
+  glm::dvec3 sum = s.occlusion * (diffuse + m.f0 * e.specular + gap * e.specular_schlick);
   // The suns as the directional lights they are, occluded like the rest of the environment
   // (as the viewers, which do not take suns out, occlude them).
   for (const EnvironmentSun& sun : environment->suns()) {
     const double n_dot_l = glm::dot(n, sun.to_light);
     if (!(n_dot_l > 0.0)) continue;
-    sum += pbr_brdf(base, s.metallic, s.roughness, n, v, sun.to_light) * sun.irradiance *
-           (n_dot_l * s.occlusion);
+    sum += pbr_brdf(m, n, v, sun.to_light) * sun.irradiance * (n_dot_l * s.occlusion);
   }
   return sum;
 }
@@ -110,60 +113,117 @@ glm::dvec3 blinn_phong_highlights(const SurfaceShading& s, const glm::dvec3& p, 
   return sum;
 }
 
-/// sum_i f(l_i, v) E_i (n . l_i)+ plus the ambient term ambient x occlusion x ((1 - f0) c_diff
-/// + f0)
-/// (a uniform environment reflected by the normal-incidence albedo; a convention of
-/// covrast, not of the glTF specification, which has no ambient light).
-glm::dvec3 pbr_radiance(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
+/// sum_i f(l_i, v) E_i (n . l_i)+ plus the ambient term ambient x occlusion x ((1 - F0_d)
+/// c_diff + F0) (a uniform environment reflected by the normal-incidence albedo; a convention
+/// of covrast, not of the glTF specification, which has no ambient light).
+glm::dvec3 pbr_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
                         const glm::dvec3& n, const glm::dvec3& v) {
-  const glm::dvec3 c_diff = base * (1.0 - s.metallic);
-  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - s.metallic) + base * s.metallic;
-  glm::dvec3 sum = s.context->ambient * s.occlusion * ((glm::dvec3(1.0) - f0) * c_diff + f0);
+  glm::dvec3 sum =
+      s.context->ambient * s.occlusion * ((glm::dvec3(1.0) - m.f0_diffuse) * m.c_diff + m.f0);
   for (const PunctualLight& light : s.context->lights) {
     const Incident in = incident(light, p);
     const double n_dot_l = glm::dot(n, in.l);
     if (!(n_dot_l > 0.0)) continue;
-    sum += pbr_brdf(base, s.metallic, s.roughness, n, v, in.l) * in.irradiance * n_dot_l;
+    sum += pbr_brdf(m, n, v, in.l) * in.irradiance * n_dot_l;
   }
   return sum;
+}
+
+/// KHR_materials_clearcoat's layer alone, without its weight clearcoat x Fc: the coat's GGX
+/// lobe D V (its roughness, its normal n_c, f0 0.04 in Fc outside) under the punctual lights,
+/// the environment (its A integral, and the suns) and the ambient light (the lobe's albedo
+/// taken as 1, as the core's ambient term takes the specular's as F0), occlusion on all but
+/// the punctual lights as for the base.
+glm::dvec3 clearcoat_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
+                              const glm::dvec3& v) {
+  const glm::dvec3& n = m.coat_normal;
+  if (n == glm::dvec3(0.0)) return glm::dvec3(0.0);
+  const double alpha = std::max(m.coat_roughness * m.coat_roughness, kMinBrdfAlpha);
+  const double alpha2 = alpha * alpha;
+  glm::dvec3 sum = s.context->ambient * s.occlusion;
+  for (const PunctualLight& light : s.context->lights) {
+    const Incident in = incident(light, p);
+    const double n_dot_l = glm::dot(n, in.l);
+    if (!(n_dot_l > 0.0)) continue;
+    sum += in.irradiance * (ggx_lobe(n, v, in.l, alpha2).d_vis * n_dot_l);
+  }
+  if (const EnvironmentLighting* environment = s.context->environment) {
+    sum += s.occlusion * environment->integrals(n, v, m.coat_roughness).specular;
+    for (const EnvironmentSun& sun : environment->suns()) {
+      const double n_dot_l = glm::dot(n, sun.to_light);
+      if (!(n_dot_l > 0.0)) continue;
+      sum += sun.irradiance * (ggx_lobe(n, v, sun.to_light, alpha2).d_vis * n_dot_l * s.occlusion);
+    }
+  }
+  return sum;
+}
+
+/// The glTF material at a point, coated (KHR_materials_clearcoat, "fresnel_coat"):
+///   L = L_base (1 - clearcoat Fc) + clearcoat Fc L_coat,  Fc = 0.04 + 0.96 (1 - |n_c . v|)^5,
+/// L_base with the emission (the coat darkens it too).
+glm::dvec3 pbr_shade(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
+                     const glm::dvec3& n, const glm::dvec3& v) {
+  const glm::dvec3 base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
+  if (!(m.clearcoat > 0.0)) return base;
+  const double coat = m.clearcoat * clearcoat_fresnel(m.coat_normal, v);
+  return base * (1.0 - coat) + clearcoat_radiance(s, m, p, v) * coat;
 }
 
 }  // namespace
 
 // glTF 2.0 specification, Appendix B.3 (https://registry.khronos.org/glTF/specs/2.0/
-// glTF-2.0.html#appendix-b-brdf-implementation), the implementation form of B.3.5:
-//   alpha = max(roughness^2, 1e-3), c_diff = lerp(base, 0, metallic), f0 = lerp(0.04, base,
-//   metallic) F = f0 + (1 - f0) (1 - |v . h|)^5 D = alpha^2 X+(n . h) / (pi ((n . h)^2 (alpha^2 -
-//   1) + 1)^2) V = X+(h . l) / (|n . l| + sqrt(alpha^2 + (1 - alpha^2) (n . l)^2))
+// glTF-2.0.html#appendix-b-brdf-implementation), the implementation form of B.3.5, with
+// KHR_materials_ior and KHR_materials_specular's F0 and F90 (PbrPoint):
+//   alpha = max(roughness^2, 1e-3), F = F0 + (F90 - F0) (1 - |v . h|)^5
+//   D = alpha^2 X+(n . h) / (pi ((n . h)^2 (alpha^2 - 1) + 1)^2)
+//   V = X+(h . l) / (|n . l| + sqrt(alpha^2 + (1 - alpha^2) (n . l)^2))
 //     x X+(h . v) / (|n . v| + sqrt(alpha^2 + (1 - alpha^2) (n . v)^2))
-//   f = (1 - F) c_diff / pi + F D V
+//   f = (1 - F_d) c_diff / pi + F D V
+// F_d is F with the dielectric F0 colour reduced to its largest channel (KHR_materials_specular:
+// the diffuse keeps what the strongest channel leaves); without the extension F_d = F.
+glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
+                    const glm::dvec3& l) {
+  const double alpha = std::max(m.roughness * m.roughness, kMinBrdfAlpha);
+  const GgxLobe lobe = ggx_lobe(n, v, l, alpha * alpha);
+  const double weight = schlick_weight(std::abs(lobe.h_dot_v));
+  const glm::dvec3 fresnel = m.f0 + (m.f90 - m.f0) * weight;
+  const glm::dvec3 fresnel_diffuse =
+      m.f0_diffuse == m.f0 ? fresnel : m.f0_diffuse + (m.f90 - m.f0_diffuse) * weight;
+  return (glm::dvec3(1.0) - fresnel_diffuse) * m.c_diff * (1.0 / kPi) + fresnel * lobe.d_vis;
+}
+
 glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
                     const glm::dvec3& v, const glm::dvec3& l) {
-  const glm::dvec3 c_diff = base * (1.0 - metallic);
-  const glm::dvec3 f0 = glm::dvec3(0.04) * (1.0 - metallic) + base * metallic;
-  // alpha = 0 (a perfect mirror) makes D = 0/0 where n = h: kept at kMinBrdfAlpha, a highlight
-  // one pixel wide that the resolve clamps.
-  const double alpha = std::max(roughness * roughness, kMinBrdfAlpha);
-  const double alpha2 = alpha * alpha;
-  const glm::dvec3 h_sum = l + v;
-  const double h_length = glm::length(h_sum);
-  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
-  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
-  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l), h_dot_v = glm::dot(h, v);
-  const glm::dvec3 fresnel = f0 + (glm::dvec3(1.0) - f0) * schlick_weight(std::abs(h_dot_v));
-  // D x V in one division: alpha^2 / (pi k^2 g_l g_v), k = (n.h)^2 (alpha^2 - 1) + 1.
-  double d_vis = 0.0;
-  if (n_dot_h > 0.0 && h_dot_l > 0.0 && h_dot_v > 0.0) {
-    const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
-    const double gl = smith_g(n_dot_l, alpha2);
-    const double gv = smith_g(n_dot_v, alpha2);
-    d_vis = alpha2 / (kPi * k * k * (gl * gv));
-  }
-  return (glm::dvec3(1.0) - fresnel) * c_diff * (1.0 / kPi) + fresnel * d_vis;
+  SurfaceShading core;
+  core.metallic = metallic;
+  core.roughness = roughness;
+  return pbr_brdf(PbrPoint(core, base, glm::dvec3(0.0)), n, v, l);
+}
+
+PbrPoint::PbrPoint(const SurfaceShading& s, const glm::dvec3& base_color,
+                   const glm::dvec3& clearcoat_normal)
+    : base(base_color),
+      metallic(s.metallic),
+      roughness(s.roughness),
+      clearcoat(s.clearcoat),
+      coat_roughness(s.clearcoat_roughness),
+      coat_normal(clearcoat_normal) {
+  // Dielectric F0 = min(f0(ior) x specular colour, 1) x specular, F90 = specular; each then
+  // lerped towards the metal's (base, 1) by metallic. At the defaults (f0 0.04, colour 1,
+  // specular 1) this is the core material's F0 = lerp(0.04, base, metallic), F90 = 1, bit for bit.
+  const glm::dvec3 dielectric_f0 =
+      glm::min(s.ior_f0 * s.specular_color, glm::dvec3(1.0)) * s.specular_weight;
+  c_diff = base * (1.0 - metallic);
+  f0 = dielectric_f0 * (1.0 - metallic) + base * metallic;
+  f90 = glm::dvec3(s.specular_weight + (1.0 - s.specular_weight) * metallic);
+  const double strongest = std::max({dielectric_f0.r, dielectric_f0.g, dielectric_f0.b});
+  f0_diffuse = dielectric_f0 == glm::dvec3(strongest)
+                   ? f0
+                   : glm::dvec3(strongest) * (1.0 - metallic) + base * metallic;
 }
 
 glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
-                       const glm::dvec3& n) {
+                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal) {
   const ShadingContext& c = *s.context;
   const glm::dvec3 to_eye = c.eye_world - p;
   const double eye_distance = glm::length(to_eye);
@@ -181,7 +241,7 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
              s.emissive;
     case LitModel::Pbr:
     default:
-      return pbr_radiance(s, base, p, n, v) + environment_pbr(s, base, n, v) + s.emissive;
+      return pbr_shade(s, PbrPoint(s, base, clearcoat_normal), p, n, v);
   }
 }
 
@@ -229,7 +289,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   const auto finish = [&](const glm::dvec3& radiance) {
     return glm::vec3(mapping.is_identity() ? radiance : tone_map(mapping, radiance));
   };
-  if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n));
+  if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n, n));
   // Textured: the surface with this point's texels (core/texture_shading.cpp).
   const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n);
   SurfaceShading s = *r.surface;
@@ -237,7 +297,12 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   s.roughness = sample.roughness;
   s.occlusion = sample.occlusion;
   s.emissive = sample.emissive;
-  return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal));
+  s.specular_weight = sample.specular_weight;
+  s.specular_color = sample.specular_color;
+  s.clearcoat = sample.clearcoat;
+  s.clearcoat_roughness = sample.clearcoat_roughness;
+  return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
+                            sample.clearcoat_normal));
 }
 
 }  // namespace covrast::detail

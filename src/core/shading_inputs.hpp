@@ -58,6 +58,11 @@ struct SurfaceTextures {
   const TextureSlot* normal = nullptr;
   const TextureSlot* occlusion = nullptr;
   const TextureSlot* emissive = nullptr;
+  const TextureSlot* specular = nullptr;             ///< KHR_materials_specular, A
+  const TextureSlot* specular_color = nullptr;       ///< KHR_materials_specular, RGB
+  const TextureSlot* clearcoat = nullptr;            ///< KHR_materials_clearcoat, R
+  const TextureSlot* clearcoat_roughness = nullptr;  ///< KHR_materials_clearcoat, G
+  const TextureSlot* clearcoat_normal = nullptr;
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -71,6 +76,15 @@ struct SurfaceShading {
   bool double_sided = true;  ///< back faces get the flipped normal (front end)
   /// Multiplies the ambient term only (the occlusion texture sets it per shading point).
   double occlusion = 1.0;
+  /// pbr: the dielectric's Fresnel reflectance at normal incidence from its ior
+  /// (KHR_materials_ior; glTF's 0.04 without it).
+  double ior_f0 = 0.04;
+  /// pbr, KHR_materials_specular: the dielectric's specular strength and F0 colour (1: none).
+  double specular_weight = 1.0;
+  glm::dvec3 specular_color{1.0};
+  /// pbr, KHR_materials_clearcoat: the coat's weight (0: none) and perceptual roughness.
+  double clearcoat = 0.0;
+  double clearcoat_roughness = 0.0;
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
@@ -102,12 +116,18 @@ struct ShadingRecord {
 
 /// The textures' contribution at one shading point (core/texture_shading.cpp).
 struct SurfaceSample {
-  glm::dvec4 base_color{1.0};  ///< multiplies the base colour; alpha for the alpha modes
-  double metallic = 1.0;       ///< the surface's, times the texture's B
-  double roughness = 1.0;      ///< the surface's, times the texture's G
-  double occlusion = 1.0;      ///< 1 + strength (R - 1)
-  glm::dvec3 emissive{0.0};    ///< the surface's, times the emissive texture
-  glm::dvec3 normal{0.0};      ///< unit, world space; the normal map applied
+  glm::dvec4 base_color{1.0};        ///< multiplies the base colour; alpha for the alpha modes
+  double metallic = 1.0;             ///< the surface's, times the texture's B
+  double roughness = 1.0;            ///< the surface's, times the texture's G
+  double occlusion = 1.0;            ///< 1 + strength (R - 1)
+  glm::dvec3 emissive{0.0};          ///< the surface's, times the emissive texture
+  glm::dvec3 normal{0.0};            ///< unit, world space; the normal map applied
+  double specular_weight = 1.0;      ///< the surface's, times the specular texture's A
+  glm::dvec3 specular_color{1.0};    ///< the surface's, times the specular colour texture
+  double clearcoat = 0.0;            ///< the surface's, times the clearcoat texture's R
+  double clearcoat_roughness = 0.0;  ///< the surface's, times the roughness texture's G
+  /// unit, world space: the clearcoat normal texture applied, else the interpolated normal
+  glm::dvec3 clearcoat_normal{0.0};
 };
 
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
@@ -130,12 +150,35 @@ WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double 
 
 /// Outgoing linear radiance at world point `p` with unit normal `n` (zero: no normal) and
 /// base colour `base` (linear): the material's model, summed over the context's lights.
+/// `clearcoat_normal` (unit, or zero) is the pbr clear coat's normal (KHR_materials_clearcoat).
 glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base, const glm::dvec3& p,
-                       const glm::dvec3& n);
+                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal);
+inline glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base,
+                              const glm::dvec3& p, const glm::dvec3& n) {
+  return shade_point(surface, base, p, n, n);
+}
+
+/// The pbr material at one shading point, its Fresnel terms prepared (core/shading.cpp):
+/// c_diff = base (1 - metallic); F0 and F90 from KHR_materials_ior and _specular, lerped to the
+/// metal's (base, 1) by metallic; F0_d, the F0 the diffuse weight uses (the dielectric F0's
+/// largest channel, lerped alike; F0 itself when the dielectric F0 is grey).
+struct PbrPoint {
+  PbrPoint(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& clearcoat_normal);
+  glm::dvec3 base;
+  double metallic;
+  double roughness;
+  glm::dvec3 c_diff, f0, f90, f0_diffuse;
+  double clearcoat;
+  double coat_roughness;
+  glm::dvec3 coat_normal;
+};
 
 /// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-
 /// Reitz D, Smith height-correlated V, Schlick F, Lambert diffuse (1 - F) c_diff / pi), for
-/// unit n, v, l; without the n . l cosine. Exposed for the tests.
+/// unit n, v, l; without the n . l cosine. The second form is the core material (no extension).
+/// Exposed for the tests.
+glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
+                    const glm::dvec3& l);
 glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
                     const glm::dvec3& v, const glm::dvec3& l);
 

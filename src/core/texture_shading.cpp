@@ -79,6 +79,27 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
   return m_length > 0.0 ? m / m_length : n;
 }
 
+/// The textures of KHR_materials_specular (strength in A, F0 colour in RGB) and
+/// KHR_materials_clearcoat (weight in R, roughness in G, its own normal map, which perturbs the
+/// interpolated normal, not the base's mapped one); each multiplies the surface's factor.
+void sample_material_extensions(const SurfaceTextures& slots, const TexturedCorners& corners,
+                                const double mu[3], const WeightDerivatives& d,
+                                SurfaceSample& out) {
+  if (slots.specular != nullptr) out.specular_weight *= lookup(*slots.specular, corners, mu, d).a;
+  if (slots.specular_color != nullptr) {
+    out.specular_color *= glm::dvec3(lookup(*slots.specular_color, corners, mu, d));
+  }
+  if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d).r;
+  if (slots.clearcoat_roughness != nullptr) {
+    out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d).g;
+  }
+  if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
+    out.clearcoat_normal =
+        perturbed_normal(lookup(*slots.clearcoat_normal, corners, mu, d),
+                         slots.clearcoat_normal->scale, corners, mu, out.clearcoat_normal);
+  }
+}
+
 }  // namespace
 
 double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
@@ -101,6 +122,11 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.roughness = s.roughness;
   out.emissive = s.emissive;
   out.normal = normal;
+  out.specular_weight = s.specular_weight;
+  out.specular_color = s.specular_color;
+  out.clearcoat = s.clearcoat;
+  out.clearcoat_roughness = s.clearcoat_roughness;
+  out.clearcoat_normal = normal;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
   if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d);
@@ -120,6 +146,7 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
     out.normal = perturbed_normal(lookup(*slots.normal, corners, mu, d), slots.normal->scale,
                                   corners, mu, normal);
   }
+  sample_material_extensions(slots, corners, mu, d, out);
   return out;
 }
 

@@ -279,12 +279,20 @@ SurfaceTextures surface_textures(const Material& m, bool lit) {
   out.normal = slot(m.normal_texture);
   out.occlusion = slot(m.occlusion_texture);
   out.emissive = slot(m.emissive_texture);
+  if (m.model != ShadingModel::Pbr) return out;
+  out.specular = slot(m.specular_texture);
+  out.specular_color = slot(m.specular_color_texture);
+  out.clearcoat = slot(m.clearcoat_texture);
+  out.clearcoat_roughness = slot(m.clearcoat_roughness_texture);
+  out.clearcoat_normal = slot(m.clearcoat_normal_texture);
   return out;
 }
 
 bool any_texture(const SurfaceTextures& t) {
   return t.base_color != nullptr || t.metallic_roughness != nullptr || t.normal != nullptr ||
-         t.occlusion != nullptr || t.emissive != nullptr;
+         t.occlusion != nullptr || t.emissive != nullptr || t.specular != nullptr ||
+         t.specular_color != nullptr || t.clearcoat != nullptr ||
+         t.clearcoat_roughness != nullptr || t.clearcoat_normal != nullptr;
 }
 
 /// Whether some instance shows a texture: an unlit scene then needs the shaded path too.
@@ -310,6 +318,14 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.alpha_cutoff = m.alpha_cutoff;
   s.base_alpha = m.base_alpha;
   s.context = context;
+  // KHR_materials_ior: f0 = ((ior - 1) / (ior + 1))^2, and glTF's own 0.04 for its default 1.5
+  // (the formula gives 0.04000000000000001 there, which would change every default material).
+  const double ior = m.ior;
+  s.ior_f0 = m.ior == 1.5f ? 0.04 : ((ior - 1.0) / (ior + 1.0)) * ((ior - 1.0) / (ior + 1.0));
+  s.specular_weight = m.specular_factor;
+  s.specular_color = glm::dvec3(m.specular_color_factor);
+  s.clearcoat = m.clearcoat;
+  s.clearcoat_roughness = m.clearcoat_roughness;
   return s;
 }
 
@@ -889,7 +905,12 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
     }
   }
   for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(0.0f);
-  if (surface.textures->normal == nullptr) return;
+  // The tangent frame of the normal maps: the normal texture's UV set, else the clearcoat
+  // normal texture's (one frame serves both).
+  const TextureSlot* normal_map = surface.textures->normal != nullptr
+                                      ? surface.textures->normal
+                                      : surface.textures->clearcoat_normal;
+  if (normal_map == nullptr) return;
   if (!mesh.corner_tangents.empty()) {
     for (int k = 0; k < 3; ++k) {
       const glm::vec4& t = mesh.corner_tangents[local * 3 + std::size_t(k)];
@@ -898,7 +919,7 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
     }
     return;
   }
-  const int set = surface.textures->normal->texcoord;
+  const int set = normal_map->texcoord;
   const glm::dvec3 e1 = glm::dvec3(out[1].position_world) - glm::dvec3(out[0].position_world);
   const glm::dvec3 e2 = glm::dvec3(out[2].position_world) - glm::dvec3(out[0].position_world);
   const glm::dvec2 d1 = glm::dvec2(out[1].uv[set]) - glm::dvec2(out[0].uv[set]);

@@ -59,6 +59,15 @@ const std::vector<Field> kPbrFields = {
     {"baseColorTexture", Kind::Object, 0, &kTextureInfoFields},
     {"metallicRoughnessTexture", Kind::Object, 0, &kTextureInfoFields}};
 
+/// material.extensions: the material extensions covrast reads are objects (their fields are
+/// checked where they are read, scene/gltf_materials.cpp).
+const std::vector<Field> kMaterialExtensionFields = {
+    {"KHR_materials_ior", Kind::Object},
+    {"KHR_materials_specular", Kind::Object},
+    {"KHR_materials_clearcoat", Kind::Object},
+    {"KHR_materials_emissive_strength", Kind::Object},
+    {"KHR_materials_unlit", Kind::Object}};
+
 /// The top-level arrays whose elements covrast reads, and the fields it reads of each.
 struct Section {
   const char* key;
@@ -107,7 +116,7 @@ const std::vector<Section>& sections() {
         {"alphaMode", Kind::String},
         {"alphaCutoff", Kind::Number},
         {"doubleSided", Kind::Bool},
-        {"extensions", Kind::Object},
+        {"extensions", Kind::Object, 0, &kMaterialExtensionFields},
         {"name", Kind::Name}}},
       {"cameras", {{"type", Kind::String}, {"name", Kind::Name}}},
       {"skins",

@@ -324,6 +324,39 @@ TextureSlot GltfTextures::slot(int texture_index, int texcoord,
   return out;
 }
 
+TextureSlot GltfTextures::info_slot(const tinygltf::Value& info, bool srgb,
+                                    const std::string& path) {
+  if (!info.IsObject() || !info.Has("index")) {
+    fail(reader_.name, path + ": expected a textureInfo object with \"index\"");
+  }
+  const tinygltf::Value& index = info.Get("index");
+  const std::optional<int> texture =
+      index.IsNumber() ? whole_number(index, 0, int(model_.textures.size()) - 1) : std::nullopt;
+  if (!texture) {
+    fail(reader_.name, path + ".index: expected the index of one of the file's " +
+                           std::to_string(model_.textures.size()) + " textures");
+  }
+  int texcoord = 0;
+  if (info.Has("texCoord")) {
+    const tinygltf::Value& set = info.Get("texCoord");
+    const std::optional<int> value =
+        set.IsNumber() ? whole_number(set, 0, kMaxTexcoordSets - 1) : std::nullopt;
+    if (!value) {
+      fail(reader_.name, path + ".texCoord: expected 0 or 1 (covrast reads TEXCOORD_0 and _1)");
+    }
+    texcoord = *value;
+  }
+  tinygltf::ExtensionMap extensions;
+  if (info.Has("extensions")) {
+    const tinygltf::Value& object = info.Get("extensions");
+    if (!object.IsObject()) fail(reader_.name, path + ".extensions: expected an object");
+    for (const std::string& key : object.Keys()) extensions.emplace(key, object.Get(key));
+  }
+  TextureSlot out = slot(*texture, texcoord, extensions, srgb, path);
+  out.scale = float(number_or(info, "scale", 1.0, reader_.name, path));
+  return out;
+}
+
 void GltfTextures::apply(const tinygltf::Material& source, int material_index, Material& m) {
   const std::string what = "material " + std::to_string(material_index);
   const tinygltf::PbrMetallicRoughness& pbr = source.pbrMetallicRoughness;

@@ -38,6 +38,10 @@ class GltfTextures {
   /// leaves its slots empty with a warning (docs/limits.md, "Missing files"); one that cannot
   /// be read or decoded is an InputError naming the file and the image.
   void apply(const tinygltf::Material& source, int material_index, Material& material);
+  /// The slot of a textureInfo (or normalTextureInfo: its "scale" too) given as JSON inside an
+  /// extension, at JSON path `path`; every field checked (index, texCoord, scale, extensions).
+  TextureSlot info_slot(const tinygltf::Value& info, bool srgb, const std::string& path);
+  const std::string& file_name() const { return reader_.name; }
 
  private:
   TextureSlot slot(int texture_index, int texcoord, const tinygltf::ExtensionMap& extensions,

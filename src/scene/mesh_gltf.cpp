@@ -13,6 +13,7 @@
 #include "scene/gltf_draco.hpp"
 #include "scene/gltf_input.hpp"
 #include "scene/gltf_lights.hpp"
+#include "scene/gltf_materials.hpp"
 #include "scene/gltf_meshopt.hpp"
 #include "scene/gltf_pose.hpp"
 #include "scene/gltf_rewrite.hpp"
@@ -226,11 +227,20 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 10> kImplementedExtensions = {
-    kDracoExtension,       "EXT_mesh_gpu_instancing", "KHR_materials_emissive_strength",
-    "KHR_materials_unlit", "KHR_mesh_quantization",   "KHR_texture_transform",
-    kLightsExtension,      "EXT_texture_webp",        kMeshoptExtension,
-    kVariantsExtension};
+constexpr std::array<std::string_view, 13> kImplementedExtensions = {
+    kDracoExtension,
+    "EXT_mesh_gpu_instancing",
+    "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    kLightsExtension,
+    "EXT_texture_webp",
+    kMeshoptExtension,
+    kVariantsExtension,
+    kIorExtension,
+    kSpecularExtension,
+    kClearcoatExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.
@@ -360,6 +370,7 @@ class GltfMeshBuilder {
       }
       mesh_->materials.push_back(convert_material(model.materials[i]));
       textures.apply(model.materials[i], int(i), mesh_->materials.back());
+      read_material_extensions(model.materials[i], int(i), textures, mesh_->materials.back());
     }
     mesh_->materials.push_back(convert_material(tinygltf::Material{}));
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
@@ -637,8 +648,7 @@ class GltfMeshBuilder {
   /// Counts a primitive whose material samples a UV set the primitive does not have.
   void count_missing_texcoords(const TextureAttributes& attributes, std::uint32_t material) {
     const Material& m = mesh_->materials[material];
-    for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                    &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+    for (const TextureSlot* slot : m.texture_slots()) {
       if (slot->texture && attributes.uv[slot->texcoord].empty()) {
         ++missing_texcoords_;
         return;

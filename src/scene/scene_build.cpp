@@ -61,8 +61,20 @@ void check_material(const Material& m, const std::string& what) {
   }
   if (!non_negative(m.emissive_linear)) fail(what, "emissive must be finite and >= 0");
   if (!non_negative(m.specular_linear)) fail(what, "specular must be finite and >= 0");
-  for (const TextureSlot* slot : {&m.base_color_texture, &m.metallic_roughness_texture,
-                                  &m.normal_texture, &m.occlusion_texture, &m.emissive_texture}) {
+  if (!(m.ior == 0.0f || (m.ior >= 1.0f && std::isfinite(m.ior)))) {
+    fail(what, "ior must be 0 or a finite number >= 1");
+  }
+  if (!(m.specular_factor >= 0.0f && m.specular_factor <= 1.0f)) {
+    fail(what, "specular_factor must be in 0..1");
+  }
+  if (!non_negative(m.specular_color_factor)) {
+    fail(what, "specular_color_factor must be finite and >= 0");
+  }
+  if (!(m.clearcoat >= 0.0f && m.clearcoat <= 1.0f)) fail(what, "clearcoat must be in 0..1");
+  if (!(m.clearcoat_roughness >= 0.0f && m.clearcoat_roughness <= 1.0f)) {
+    fail(what, "clearcoat_roughness must be in 0..1");
+  }
+  for (const TextureSlot* slot : m.texture_slots()) {
     if (slot->texcoord < 0 || slot->texcoord >= kMaxTexcoordSets) {
       fail(what, "a texture's texcoord must be 0 or 1");
     }

@@ -388,6 +388,27 @@ class SceneReader {
          "expected \"unlit\", \"lambert\", \"blinn-phong\" or \"pbr\", got " + shown(value));
   }
 
+  /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat).
+  void apply_material_extensions(const json& object, const std::string& key, Material& m) const {
+    if (const auto it = object.find("ior"); it != object.end()) {
+      const double ior = number_in(*it, key + ".ior", 0.0, 1e6);
+      if (ior != 0.0 && ior < 1.0) {
+        fail(file_, key + ".ior", "expected 0 or a number >= 1, got " + shown(*it));
+      }
+      m.ior = static_cast<float>(ior);
+    }
+    if (const auto it = object.find("specular_factor"); it != object.end()) {
+      m.specular_factor = static_cast<float>(number_in(*it, key + ".specular_factor", 0.0, 1.0));
+    }
+    if (const auto it = object.find("clearcoat"); it != object.end()) {
+      m.clearcoat = static_cast<float>(number_in(*it, key + ".clearcoat", 0.0, 1.0));
+    }
+    if (const auto it = object.find("clearcoat_roughness"); it != object.end()) {
+      m.clearcoat_roughness =
+          static_cast<float>(number_in(*it, key + ".clearcoat_roughness", 0.0, 1.0));
+    }
+  }
+
   /// Applies the keys of a scene "material" object to `m` (keys not given keep its value).
   void apply_material(const json& object, const std::string& key, Material& m) const {
     if (const auto it = object.find("model"); it != object.end()) {
@@ -409,6 +430,7 @@ class SceneReader {
       m.specular_linear =
           glm::vec3(static_cast<float>(number_in(*it, key + ".specular", 0.0, 1.0)));
     }
+    apply_material_extensions(object, key, m);
     if (const auto it = object.find("double_sided"); it != object.end()) {
       if (!it->is_boolean()) {
         fail(file_, key + ".double_sided", "expected true or false, got " + shown(*it));

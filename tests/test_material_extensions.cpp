@@ -1,0 +1,475 @@
+// Tests of the glTF material extensions covrast honours (docs/shading.md, "Material
+// extensions"): KHR_materials_ior, KHR_materials_specular and KHR_materials_clearcoat.
+// - On the lit sphere of test_sphere_scene.hpp, every interior pixel in three modes against the
+//   extensions' formulas written out here from their specifications (not from covrast's code).
+// - The coat under the environment, the suns and the ambient light: the layering identity.
+// - The glTF reader: the fields and textures, neutral values drawing the bytes of a file
+//   without the extensions, and each wrong value an error naming its JSON path.
+#include <covrast/error.hpp>
+#include <covrast/renderer.hpp>
+#include <covrast/scene.hpp>
+
+#include "core/environment_lighting.hpp"
+#include "core/shading_inputs.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <numbers>
+#include <string>
+#include <vector>
+
+#include "test_gltf_files.hpp"
+#include "test_sphere_scene.hpp"
+#include "test_tempdir.hpp"
+
+using Catch::Matchers::Contains;
+using covrast::Light;
+using covrast::LightType;
+using covrast::Material;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// GGX D and the height-correlated Smith V of glTF Appendix B.3.5, written out.
+double ggx_d(double alpha, double n_h) {
+  if (!(n_h > 0.0)) return 0.0;
+  const double a2 = alpha * alpha;
+  return a2 / (kPi * std::pow(n_h * n_h * (a2 - 1.0) + 1.0, 2.0));
+}
+double smith_v(double alpha, double n_l, double n_v, double h_l, double h_v) {
+  if (!(h_l > 0.0 && h_v > 0.0)) return 0.0;
+  const double a2 = alpha * alpha;
+  const auto g = [&](double x) { return std::abs(x) + std::sqrt(a2 + (1.0 - a2) * x * x); };
+  return 1.0 / (g(n_l) * g(n_v));
+}
+
+/// The lit sphere's sun and sky.
+const glm::dvec3 kSunDirection = glm::normalize(glm::dvec3(-0.3, -0.4, -1.0));
+constexpr double kSun = 2.0, kSky = 0.1;
+
+/// The material of `m` (metallic 0 or 1) with base colour `base`, under kSun from
+/// -kSunDirection and the ambient kSky, at normal n and view v, from the specifications:
+///   KHR_materials_ior       f0 = ((ior - 1) / (ior + 1))^2
+///   KHR_materials_specular  F0_d = min(f0 x specularColor, 1) x specular, F90_d = specular,
+///                           dielectric = (1 - max(F_d)) base / pi + F_d D V,
+///                           F_d = F0_d + (F90_d - F0_d) (1 - |v.h|)^5
+///   core                    f = (1 - metallic) dielectric + metallic (base + (1 - base) s) D V
+///   KHR_materials_clearcoat L = L_base (1 - clearcoat Fc) + clearcoat Fc L_coat,
+///                           Fc = 0.04 + 0.96 (1 - |n.v|)^5, L_coat with the coat's D V
+/// with covrast's ambient convention (ambient x the normal-incidence albedo; 1 for the coat's
+/// lobe) and the emission under the coat.
+glm::dvec3 extended_pbr(const Material& m, const glm::dvec3& base, const glm::dvec3& n,
+                        const glm::dvec3& v) {
+  const glm::dvec3 l = -kSunDirection;
+  const glm::dvec3 h = glm::normalize(l + v);
+  const double n_l = glm::dot(n, l), n_v = glm::dot(n, v), n_h = glm::dot(n, h);
+  const double h_l = glm::dot(h, l), h_v = glm::dot(h, v);
+  const double s = std::pow(1.0 - std::abs(h_v), 5.0);
+  const double ior = m.ior;
+  const double f0 = ior == 1.5 ? 0.04 : std::pow((ior - 1.0) / (ior + 1.0), 2.0);
+  const double spec = m.specular_factor, metallic = m.metallic;
+  glm::dvec3 f0_d, f_d;
+  for (int c = 0; c < 3; ++c) {
+    f0_d[c] = std::min(f0 * m.specular_color_factor[c], 1.0) * spec;
+    f_d[c] = f0_d[c] + (spec - f0_d[c]) * s;
+  }
+  const double max_f0_d = std::max({f0_d.r, f0_d.g, f0_d.b});
+  const double max_f_d = std::max({f_d.r, f_d.g, f_d.b});
+  const double alpha = std::max(double(m.roughness) * m.roughness, 1e-3);
+  const double dv = ggx_d(alpha, n_h) * smith_v(alpha, n_l, n_v, h_l, h_v);
+  glm::dvec3 out;
+  for (int c = 0; c < 3; ++c) {
+    const double dielectric = (1.0 - max_f_d) * base[c] / kPi + f_d[c] * dv;
+    const double metal = (base[c] + (1.0 - base[c]) * s) * dv;
+    const double f = (1.0 - metallic) * dielectric + metallic * metal;
+    const double f0_c = f0_d[c] * (1.0 - metallic) + base[c] * metallic;
+    const double ambient = kSky * ((1.0 - max_f0_d) * base[c] * (1.0 - metallic) + f0_c);
+    out[c] = ambient + kSun * std::max(0.0, n_l) * f + m.emissive_linear[c];
+  }
+  if (m.clearcoat > 0.0f) {
+    const double fc = 0.04 + 0.96 * std::pow(1.0 - std::abs(n_v), 5.0);
+    const double coat_alpha = std::max(double(m.clearcoat_roughness) * m.clearcoat_roughness, 1e-3);
+    const double coat_dv = ggx_d(coat_alpha, n_h) * smith_v(coat_alpha, n_l, n_v, h_l, h_v);
+    const double coat = kSky + kSun * std::max(0.0, n_l) * coat_dv;
+    const double w = m.clearcoat * fc;
+    out = out * (1.0 - w) + glm::dvec3(coat * w);
+  }
+  return out;
+}
+
+/// The lit sphere with `m`, sun and sky.
+covrast::Scene extension_sphere(const glm::dvec3& base, const Material& m) {
+  covrast::Scene scene = covrast::test::lit_sphere_scene(glm::vec3(base), m);
+  Light sun;
+  sun.type = LightType::Directional;
+  sun.direction = kSunDirection;
+  sun.intensity = kSun;
+  Light sky;
+  sky.type = LightType::Ambient;
+  sky.intensity = kSky;
+  scene.lights = {sun, sky};
+  return scene;
+}
+
+/// The 8-bit codes of `expected(n, v)` at image point (x, y) of the sphere seen from (0, 0, 3)
+/// (as test_sphere_scene.hpp's worst_sphere_difference), or false off the interior.
+bool formula_codes(const covrast::Scene& scene, double x, double y,
+                   const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected,
+                   int codes[3]) {
+  const double t = std::tan(scene.camera.fovy_deg * kPi / 360.0);
+  const glm::dvec3 d = glm::normalize(
+      glm::dvec3((2.0 * x / scene.width - 1.0) * t, (1.0 - 2.0 * y / scene.height) * t, -1.0));
+  const glm::dvec3 o = scene.camera.eye;
+  const double b = glm::dot(o, d), disc = b * b - (glm::dot(o, o) - 1.0);
+  if (disc <= 0.0) return false;
+  const glm::dvec3 n = o + (-b - std::sqrt(disc)) * d;
+  if (glm::dot(n, -d) < 0.3) return false;
+  const glm::dvec3 value = expected(n, -d);
+  for (int c = 0; c < 3; ++c) codes[c] = covrast::detail::encode_srgb8(float(value[c]));
+  return true;
+}
+
+/// The largest difference between `image` and the formula at the pixel centres of the interior.
+/// With `smooth_only`, only over the pixels where the formula changes by at most one code
+/// within 0.75 pixel of the centre: coverage and msaa shade each triangle of a pixel at the
+/// centre clamped into it, up to 0.7 pixel away, so where the formula is steeper (a sharp
+/// highlight) they differ from the centre's value by what the formula changes over that
+/// distance, not by an error of the material.
+int worst_difference(
+    const covrast::Image& image, const covrast::Scene& scene,
+    const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected,
+    bool smooth_only, int& checked) {
+  int worst = 0;
+  checked = 0;
+  for (int y = 0; y < scene.height; ++y) {
+    for (int x = 0; x < scene.width; ++x) {
+      int centre[3];
+      if (!formula_codes(scene, x + 0.5, y + 0.5, expected, centre)) continue;
+      bool smooth = true;
+      for (int k = 0; smooth_only && smooth && k < 4; ++k) {
+        int near[3];
+        smooth = formula_codes(scene, x + 0.5 + (k & 1 ? 0.75 : -0.75),
+                               y + 0.5 + (k & 2 ? 0.75 : -0.75), expected, near);
+        for (int c = 0; smooth && c < 3; ++c) smooth = std::abs(near[c] - centre[c]) <= 1;
+      }
+      if (!smooth) continue;
+      const std::uint8_t* p = image.pixel(x, y);
+      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(p[c]) - centre[c]));
+      ++checked;
+    }
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("ior specular and clearcoat on a lit sphere match their formulas at every pixel",
+          "[shading][analytic][extensions]") {
+  struct Case {
+    const char* name;
+    Material material;
+  };
+  std::vector<Case> cases;
+  const auto add = [&](const char* name, auto set) {
+    Material m;
+    m.model = covrast::ShadingModel::Pbr;
+    m.metallic = 0.0f;
+    m.roughness = 0.5f;
+    set(m);
+    cases.push_back({name, m});
+  };
+  add("ior 1.8", [](Material& m) { m.ior = 1.8f; });
+  add("ior 0 (f0 = 1)", [](Material& m) { m.ior = 0.0f; });
+  add("specular 0.4, coloured", [](Material& m) {
+    m.specular_factor = 0.4f;
+    m.specular_color_factor = glm::vec3(1.0f, 0.5f, 2.0f);
+  });
+  add("specular colour clamped, ior 3", [](Material& m) {
+    m.ior = 3.0f;
+    m.specular_color_factor = glm::vec3(8.0f, 1.0f, 0.0f);
+  });
+  add("metal: specular changes nothing", [](Material& m) {
+    m.metallic = 1.0f;
+    m.specular_factor = 0.3f;
+    m.specular_color_factor = glm::vec3(2.0f, 1.0f, 0.5f);
+  });
+  add("clearcoat 1, smooth coat", [](Material& m) {
+    m.roughness = 0.6f;
+    m.clearcoat = 1.0f;
+    m.clearcoat_roughness = 0.1f;
+  });
+  add("clearcoat 0.5 over ior, specular and emission", [](Material& m) {
+    m.clearcoat = 0.5f;
+    m.clearcoat_roughness = 0.3f;
+    m.ior = 1.4f;
+    m.specular_factor = 0.7f;
+    m.emissive_linear = glm::vec3(0.05f, 0.0f, 0.02f);
+  });
+  add("clearcoat over a metal", [](Material& m) {
+    m.metallic = 1.0f;
+    m.roughness = 0.35f;
+    m.clearcoat = 0.8f;
+    m.clearcoat_roughness = 0.05f;
+  });
+  const glm::dvec3 base(0.6, 0.3, 0.2);
+  for (const Case& c : cases) {
+    const covrast::Scene scene = extension_sphere(base, c.material);
+    const auto formula = [&](const glm::dvec3& n, const glm::dvec3& v) {
+      return extended_pbr(c.material, base, n, v);
+    };
+    for (const char* mode : {"coverage", "aliased", "msaa:4"}) {
+      INFO(c.name << ", " << mode);
+      // Aliased shades at the pixel centre: every interior pixel. The others: where the
+      // formula is smooth at the pixel's scale (worst_difference).
+      const bool aliased = std::string(mode) == "aliased";
+      int checked = 0;
+      CHECK(worst_difference(covrast::test::render_mode(scene, mode), scene, formula, !aliased,
+                             checked) <= 1);
+      CHECK(checked > (aliased ? 3000 : 1500));
+    }
+  }
+}
+
+TEST_CASE("the clear coat under the environment with its suns and the ambient light",
+          "[shading][extensions][environment]") {
+  // fresnel_coat: coated = base x (1 - c Fc) + c Fc x coat, and the coat's lobe alone (D V, no
+  // Fresnel, albedo 1 under the ambient light) is what a white metal (F = 1) of the coat's
+  // roughness reflects: so the coated material is the two uncoated ones mixed, at every normal,
+  // view and coat normal, under every kind of light at once.
+  using namespace covrast::detail;
+  // The studio environment with one texel bright enough to be lit as a sun.
+  auto map = std::make_shared<covrast::EnvironmentMap>(*covrast::studio_environment());
+  map->radiance_linear[std::size_t(map->height / 4) * map->width + map->width / 3] =
+      glm::vec3(5000.0f);
+  const covrast::EnvironmentLight light{map, 30.0, 1.0};
+  const EnvironmentLighting lighting(light);
+  REQUIRE_FALSE(lighting.suns().empty());
+  ShadingContext context;
+  context.environment = &lighting;
+  context.ambient = glm::dvec3(0.05, 0.04, 0.03);
+  PunctualLight sun;
+  sun.to_light = glm::normalize(glm::dvec3(0.2, 0.9, 0.4));
+  sun.radiance = glm::dvec3(1.5);
+  context.lights = {sun};
+  SurfaceShading coated;
+  coated.model = LitModel::Pbr;
+  coated.metallic = 0.2;
+  coated.roughness = 0.55;
+  coated.occlusion = 0.8;
+  coated.emissive = glm::dvec3(0.02, 0.01, 0.0);
+  coated.context = &context;
+  coated.clearcoat = 0.7;
+  coated.clearcoat_roughness = 0.15;
+  SurfaceShading uncoated = coated;
+  uncoated.clearcoat = 0.0;
+  SurfaceShading lobe = coated;
+  lobe.clearcoat = 0.0;
+  lobe.metallic = 1.0;
+  lobe.roughness = coated.clearcoat_roughness;
+  lobe.emissive = glm::dvec3(0.0);
+  const glm::dvec3 base(0.7, 0.2, 0.1), white(1.0);
+  int compared = 0, coat_shows = 0;
+  for (int k = 0; k < 24; ++k) {
+    const double z = 1.0 - (k + 0.5) / 12.0, phi = 2.399963 * k;
+    const glm::dvec3 n(std::sqrt(1.0 - z * z) * std::cos(phi), z,
+                       std::sqrt(1.0 - z * z) * std::sin(phi));
+    const glm::dvec3 v = glm::normalize(n + glm::dvec3(0.3 * std::sin(k), 0.2, 0.3 * std::cos(k)));
+    const glm::dvec3 coat_normal = glm::normalize(n + glm::dvec3(0.1, -0.05, 0.08) * double(k % 3));
+    context.eye_world = v * 4.0;
+    const double fc = 0.04 + 0.96 * std::pow(1.0 - std::abs(glm::dot(coat_normal, v)), 5.0);
+    const double w = coated.clearcoat * fc;
+    const glm::dvec3 want =
+        shade_point(uncoated, base, glm::dvec3(0.0), n, coat_normal) * (1.0 - w) +
+        shade_point(lobe, white, glm::dvec3(0.0), coat_normal) * w;
+    const glm::dvec3 got = shade_point(coated, base, glm::dvec3(0.0), n, coat_normal);
+    INFO("normal " << k);
+    for (int c = 0; c < 3; ++c) CHECK(got[c] == Approx(want[c]).epsilon(1e-12));
+    // The coat is there: it changes the colour by more than rounding (not where the view
+    // meets the coat's light at no angle worth a reflection: a few of the 24).
+    const glm::dvec3 bare = shade_point(uncoated, base, glm::dvec3(0.0), n, coat_normal);
+    coat_shows += std::abs(got.r - bare.r) > 1e-3;
+    ++compared;
+  }
+  CHECK(compared == 24);
+  CHECK(coat_shows >= 18);
+}
+
+namespace {
+
+/// A unit sphere (24 x 48 quads) as a glTF file with exact normals, UVs and one material whose
+/// "extensions" are `extensions` (null: none), plus one 2x2 PNG texture the extensions may use.
+std::string sphere_gltf(const nlohmann::json& extensions) {
+  const auto sphere = covrast::test::uv_sphere(24, 48);
+  std::vector<float> positions, uvs;
+  for (const glm::vec3& p : sphere->positions) {
+    positions.insert(positions.end(), {p.x, p.y, p.z});
+    uvs.insert(uvs.end(), {0.5f + 0.5f * p.x, 0.5f - 0.5f * p.y});
+  }
+  std::vector<std::uint16_t> indices(sphere->indices.begin(), sphere->indices.end());
+  REQUIRE(sphere->positions.size() < 65536);
+  covrast::test::GltfBuilder b;
+  const int pos = b.add_floats(positions, "VEC3");
+  const int normal = b.add_floats(positions, "VEC3");
+  const int uv = b.add_floats(uvs, "VEC2");
+  const int index = b.add_u16(indices, "SCALAR");
+  b.single_mesh({{{"attributes", {{"POSITION", pos}, {"NORMAL", normal}, {"TEXCOORD_0", uv}}},
+                  {"indices", index},
+                  {"material", 0}}});
+  nlohmann::json material = {{"pbrMetallicRoughness",
+                              {{"baseColorFactor", {0.6, 0.3, 0.2, 1.0}},
+                               {"metallicFactor", 0.0},
+                               {"roughnessFactor", 0.5}}}};
+  if (!extensions.is_null()) material["extensions"] = extensions;
+  b.gltf["materials"] = nlohmann::json::array({material});
+  covrast::Image texel;
+  texel.width = texel.height = 2;
+  texel.rgb = {200, 100, 50, 200, 100, 50, 200, 100, 50, 200, 100, 50};
+  const std::vector<std::uint8_t> png = covrast::encode_png(texel);
+  const int view = b.add_view(std::string(png.begin(), png.end()));
+  b.gltf["images"] = {{{"bufferView", view}, {"mimeType", "image/png"}}};
+  b.gltf["textures"] = {{{"source", 0}}};
+  return b.glb();
+}
+
+/// The file lit by a sun, the sky and the studio environment, seen from (0, 0, 3), 64 x 64.
+covrast::Image render_lit(const std::filesystem::path& file, const char* mode) {
+  covrast::Scene scene = covrast::load_mesh_scene(file, 64, 64);
+  scene.camera.eye = {0.0, 0.0, 3.0};
+  scene.camera.target = {0.0, 0.0, 0.0};
+  scene.camera.up = {0.0, 1.0, 0.0};
+  scene.camera.fovy_deg = 40.0;
+  scene.camera.near = 0.5;
+  scene.camera.far = 10.0;
+  scene.lit = true;
+  Light sun;
+  sun.direction = kSunDirection;
+  sun.intensity = kSun;
+  scene.lights = {sun};
+  scene.environment = covrast::EnvironmentLight{covrast::studio_environment(), 0.0, 0.5};
+  return covrast::test::render_mode(scene, mode);
+}
+
+}  // namespace
+
+TEST_CASE("glTF material extensions at their neutral values draw today's bytes",
+          "[gltf][extensions]") {
+  covrast::test::TempDir dir("covrast-material-extensions");
+  std::ofstream(dir / "plain.glb", std::ios::binary) << sphere_gltf(nullptr);
+  const nlohmann::json neutral = {
+      {"KHR_materials_ior", {{"ior", 1.5}}},
+      {"KHR_materials_specular", {{"specularFactor", 1.0}, {"specularColorFactor", {1, 1, 1}}}},
+      {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}, {"clearcoatRoughnessFactor", 0.4}}}};
+  std::ofstream(dir / "neutral.glb", std::ios::binary) << sphere_gltf(neutral);
+  nlohmann::json coated = neutral;
+  coated["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.0;
+  std::ofstream(dir / "coated.glb", std::ios::binary) << sphere_gltf(coated);
+  for (const char* mode : {"coverage", "aliased", "msaa:4"}) {
+    INFO(mode);
+    const covrast::Image plain = render_lit(dir / "plain.glb", mode);
+    CHECK((render_lit(dir / "neutral.glb", mode).rgb == plain.rgb));
+    CHECK((render_lit(dir / "coated.glb", mode).rgb != plain.rgb));
+  }
+}
+
+TEST_CASE("glTF material extensions: fields and textures read and wrong values named by path",
+          "[gltf][extensions]") {
+  covrast::test::TempDir dir("covrast-material-extensions");
+  const nlohmann::json all = {{"KHR_materials_ior", {{"ior", 1.33}}},
+                              {"KHR_materials_specular",
+                               {{"specularFactor", 0.25},
+                                {"specularColorFactor", {2.0, 1.0, 0.5}},
+                                {"specularTexture", {{"index", 0}}},
+                                {"specularColorTexture", {{"index", 0}, {"texCoord", 0}}}}},
+                              {"KHR_materials_clearcoat",
+                               {{"clearcoatFactor", 0.75},
+                                {"clearcoatRoughnessFactor", 0.125},
+                                {"clearcoatTexture", {{"index", 0}}},
+                                {"clearcoatRoughnessTexture", {{"index", 0}}},
+                                {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.5}}}}}};
+  std::ofstream(dir / "all.glb", std::ios::binary) << sphere_gltf(all);
+  const covrast::Scene scene = covrast::load_mesh_scene(dir / "all.glb", 32, 32);
+  for (const std::string& warning : scene.warnings)
+    CHECK(warning.find("KHR_materials") == std::string::npos);
+  const Material& m = scene.meshes.at(0).mesh->materials.at(0);
+  CHECK(m.ior == 1.33f);
+  CHECK(m.specular_factor == 0.25f);
+  CHECK(m.specular_color_factor == glm::vec3(2.0f, 1.0f, 0.5f));
+  CHECK(m.clearcoat == 0.75f);
+  CHECK(m.clearcoat_roughness == 0.125f);
+  REQUIRE(m.specular_texture.texture);
+  CHECK_FALSE(m.specular_texture.texture->srgb);
+  REQUIRE(m.specular_color_texture.texture);
+  CHECK(m.specular_color_texture.texture->srgb);  // specularColorTexture is sRGB
+  REQUIRE(m.clearcoat_texture.texture);
+  REQUIRE(m.clearcoat_roughness_texture.texture);
+  REQUIRE(m.clearcoat_normal_texture.texture);
+  CHECK(m.clearcoat_normal_texture.scale == 0.5f);
+  // The textured coat draws: the coat texture's R (200/255) scales clearcoatFactor, so it
+  // differs from the same file without the coat texture.
+  nlohmann::json untextured = all;
+  untextured["KHR_materials_clearcoat"].erase("clearcoatTexture");
+  std::ofstream(dir / "untextured.glb", std::ios::binary) << sphere_gltf(untextured);
+  CHECK((render_lit(dir / "all.glb", "aliased").rgb !=
+         render_lit(dir / "untextured.glb", "aliased").rgb));
+
+  struct Bad {
+    nlohmann::json extensions;
+    std::string message;
+  };
+  const std::string path = "materials[0].extensions.";
+  const std::vector<Bad> bad = {
+      {{{"KHR_materials_clearcoat", {{"clearcoatFactor", "1"}}}},
+       path + "KHR_materials_clearcoat.clearcoatFactor: expected a number in 0..1"},
+      {{{"KHR_materials_clearcoat", {{"clearcoatRoughnessFactor", 1.5}}}},
+       path + "KHR_materials_clearcoat.clearcoatRoughnessFactor: expected a number in 0..1"},
+      {{{"KHR_materials_clearcoat", {{"clearcoatTexture", {{"index", 7}}}}}},
+       path + "KHR_materials_clearcoat.clearcoatTexture.index: expected the index of one of the "
+              "file's 1 textures"},
+      {{{"KHR_materials_clearcoat", {{"clearcoatNormalTexture", {{"index", 0}, {"texCoord", 3}}}}}},
+       path + "KHR_materials_clearcoat.clearcoatNormalTexture.texCoord: expected 0 or 1"},
+      {{{"KHR_materials_clearcoat", {{"clearcoatNormalTexture", {{"index", 0}, {"scale", "x"}}}}}},
+       path + "KHR_materials_clearcoat.clearcoatNormalTexture.scale: expected a number"},
+      {{{"KHR_materials_clearcoat", {{"clearcoatTexture", -1}}}},
+       path + "KHR_materials_clearcoat.clearcoatTexture: expected a textureInfo object"},
+      {{{"KHR_materials_clearcoat", 1}},
+       path + "KHR_materials_clearcoat: expected an object, got 1"},
+      {{{"KHR_materials_ior", {{"ior", 0.5}}}},
+       path + "KHR_materials_ior.ior: expected 0 or a number >= 1"},
+      {{{"KHR_materials_ior", {{"ior", "1.5"}}}},
+       path + "KHR_materials_ior.ior: expected 0 or a number >= 1"},
+      {{{"KHR_materials_specular", {{"specularFactor", -0.1}}}},
+       path + "KHR_materials_specular.specularFactor: expected a number in 0..1"},
+      {{{"KHR_materials_specular", {{"specularColorFactor", {1, 2}}}}},
+       path + "KHR_materials_specular.specularColorFactor: expected an array of 3 numbers >= 0"},
+      {{{"KHR_materials_specular", {{"specularColorFactor", {1, -2, 0}}}}},
+       path + "KHR_materials_specular.specularColorFactor: expected an array of 3 numbers >= 0"},
+  };
+  for (const Bad& b : bad) {
+    INFO(b.extensions.dump());
+    std::ofstream(dir / "bad.glb", std::ios::binary) << sphere_gltf(b.extensions);
+    CHECK_THROWS_AS(covrast::load_mesh(dir / "bad.glb"), covrast::InputError);
+    CHECK_THROWS_WITH(covrast::load_mesh(dir / "bad.glb"), Contains(b.message));
+  }
+}
+
+TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[scene][extensions]") {
+  covrast::test::TempDir dir("covrast-material-keys");
+  std::ofstream(dir / "t.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  std::ofstream(dir / "s.json") << R"({"width": 8, "height": 8,
+      "camera": {"eye": [0, 0, 5], "target": [0, 0, 0], "up": [0, 1, 0], "fovy_deg": 40,
+                 "near": 0.1, "far": 10},
+      "lights": [{"type": "ambient"}],
+      "meshes": [{"obj": "t.obj", "material": {"model": "pbr", "ior": 0, "specular_factor": 0.5,
+                  "clearcoat": 1, "clearcoat_roughness": 0.25}}]})";
+  const covrast::Scene scene = covrast::load_scene(dir / "s.json");
+  const Material& m = scene.meshes.at(0).materials.at(0);
+  CHECK(m.ior == 0.0f);
+  CHECK(m.specular_factor == 0.5f);
+  CHECK(m.clearcoat == 1.0f);
+  CHECK(m.clearcoat_roughness == 0.25f);
+}
