@@ -313,6 +313,22 @@ struct SceneChoices {
   std::string material_variant;  ///< KHR_materials_variants name; empty: the scene's own
 };
 
+/// Every problem covrast finds in a scene file or a mesh file (`covrast info --validate`).
+struct Validation {
+  /// What stops the load, one line each naming the file: for a glTF file, every field covrast
+  /// reads that has the wrong JSON type, each with its JSON path (the load stops at the
+  /// first); otherwise the load's own error, if any. Empty: the file loads.
+  std::vector<std::string> errors;
+  /// What the load ignores or leaves out (the scene's warnings, or the glTF type check's
+  /// warnings for fields covrast does not use when it has errors).
+  std::vector<std::string> warnings;
+};
+
+/// Validates a scene file (JSON) or a mesh file (.obj, .gltf, .glb, framed as
+/// load_mesh_scene frames it) with `choices` as load_scene takes them. Never throws
+/// InputError: each becomes an error line.
+Validation validate_file(const std::filesystem::path& path, const SceneChoices& choices = {});
+
 /// Loads a scene file. Throws InputError with a one-line message naming the file and the
 /// problem (with line and column for malformed JSON).
 Scene load_scene(const std::filesystem::path& json_path);

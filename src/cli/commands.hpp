@@ -65,6 +65,8 @@ struct ScenarioArgs {
 struct InfoArgs {
   std::string scene;
   bool json = false;
+  bool validate = false;  ///< --validate: list every finding instead of describing the scene
+  bool strict = false;    ///< --strict (with --validate): warnings make the exit status 2
   ViewArgs view;
 };
 
@@ -130,6 +132,10 @@ void apply_view_args(Scene& scene, const ViewArgs& args);
 /// prints each to stderr as "warning: ...".
 void report_scene_warnings(const std::string& what, const std::vector<std::string>& warnings,
                            bool strict);
+
+/// What `view`'s --variant, --time and --animation choose (SceneChoices); InputError for a
+/// --time that is not a finite number of seconds >= 0.
+SceneChoices scene_choices(const ViewArgs& view);
 
 /// The scene a command's SCENE argument names: a scene JSON file, or a mesh file (.obj, .gltf,
 /// .glb, any case) framed and lit without a scene file (load_mesh_scene), at `width` x

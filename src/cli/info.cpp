@@ -275,11 +275,40 @@ CLI::App* add_info_command(CLI::App& app, InfoArgs& args) {
       ->required()
       ->type_name("SCENE.json|MODEL");
   sub->add_flag("--json", args.json, "Print one JSON line instead of text");
+  sub->add_flag("--validate", args.validate,
+                "List every error and warning the file gives (for glTF, every field of a wrong "
+                "type with its JSON path) instead of describing it; exit 2 when there is an "
+                "error");
+  sub->add_flag("--strict", args.strict, "With --validate: a warning also makes the exit status 2")
+      ->needs("--validate");
   add_view_options(sub, args.view);
   return sub;
 }
 
+/// `info --validate`: the file's findings, one per line ("error: ..." then "warning: ..."),
+/// or one JSON line; exit 2 when there is an error (with --strict, also a warning).
+static int run_validate(const InfoArgs& args) {
+  const Validation found = validate_file(args.scene, scene_choices(args.view));
+  const bool failed = !found.errors.empty() || (args.strict && !found.warnings.empty());
+  if (args.json) {
+    std::cout << nlohmann::json{{"file", args.scene},
+                                {"valid", !failed},
+                                {"errors", found.errors},
+                                {"warnings", found.warnings}}
+                     .dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)
+              << '\n';
+  } else {
+    std::cout << args.scene << ": " << found.errors.size()
+              << (found.errors.size() == 1 ? " error, " : " errors, ") << found.warnings.size()
+              << (found.warnings.size() == 1 ? " warning" : " warnings") << '\n';
+    for (const std::string& e : found.errors) std::cout << "error: " << e << '\n';
+    for (const std::string& w : found.warnings) std::cout << "warning: " << w << '\n';
+  }
+  return failed ? 2 : 0;
+}
+
 int run_info(const InfoArgs& args) {
+  if (args.validate) return run_validate(args);
   Scene scene = load_scene_or_model(args.scene, args.view);
   apply_view_args(scene, args.view);
   const Bounds bounds = world_bounds(scene);

@@ -32,7 +32,7 @@ bool is_mesh_file(const std::string& path) {
 
 }  // namespace
 
-Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int width, int height) {
+SceneChoices scene_choices(const ViewArgs& view) {
   SceneChoices choices;
   choices.material_variant = view.variant;
   std::optional<AnimationTime>& pose = choices.pose;
@@ -50,6 +50,11 @@ Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int wid
       pose->name = a;
     }
   }
+  return choices;
+}
+
+Scene load_scene_or_model(const std::string& path, const ViewArgs& view, int width, int height) {
+  const SceneChoices choices = scene_choices(view);
   if (!is_mesh_file(path)) return load_scene(path, choices);
   return load_mesh_scene(path, width > 0 ? width : 640, height > 0 ? height : 360, choices);
 }

@@ -5,6 +5,8 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <memory>
 #include <system_error>
@@ -85,6 +87,13 @@ bool read_whole_file(const std::filesystem::path& path, std::string& contents, s
 bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned char>& contents,
                      std::string& error, std::uint64_t max_bytes) {
   return read_whole_file_into(path, contents, error, max_bytes);
+}
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
 }
 
 }  // namespace covrast::detail

@@ -25,6 +25,10 @@ bool read_whole_file(const std::filesystem::path& path, std::vector<unsigned cha
 /// file (and for one that does not exist, which opening reports).
 std::string unreadable_kind(const std::filesystem::file_status& status);
 
+/// `path`'s extension in lower case (".glb" for "Model.GLB"): how the loaders and writers tell
+/// formats apart.
+std::string lower_extension(const std::filesystem::path& path);
+
 /// "1 GiB", "64 MiB" or "N bytes".
 std::string size_text(std::uint64_t bytes);
 

@@ -231,13 +231,6 @@ Bytes encode_pfm(const DepthImage& depth) {
   return out;
 }
 
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 }  // namespace
 
 namespace {
@@ -332,7 +325,7 @@ std::vector<PngText> read_png_text(const std::filesystem::path& path) {
 }
 
 void write_depth(const DepthImage& depth, const std::filesystem::path& path) {
-  const std::string ext = lower_extension(path);
+  const std::string ext = detail::lower_extension(path);
   if (ext != ".png" && ext != ".pfm") {
     throw InputError(path.string() + ": unsupported depth format '" + ext +
                      "' (use .png for 16-bit greyscale or .pfm for float)");

@@ -218,11 +218,22 @@ const char* kind_text(Kind kind) {
   return "";
 }
 
+/// What the schema check found: errors (wrong types of fields covrast uses) and warnings (of
+/// fields it ignores), each a message starting with the JSON path, in document order.
+struct SchemaFindings {
+  std::vector<std::string> errors;
+  std::vector<std::string> warnings;
+};
+
 /// Checks the fields of `object` at JSON path `path`: a wrong type of a field covrast uses is
-/// an InputError; of one it ignores (Kind::Name), a line in `warn`.
+/// an error; of one it ignores (Kind::Name), a warning. Goes on past each, so that every
+/// finding is listed.
 void check_fields(const json& object, const std::vector<Field>& fields, const std::string& path,
-                  const std::string& name, std::string& warn) {
-  if (!object.is_object()) fail(name, path + ": expected an object, got " + shown(object));
+                  SchemaFindings& found) {
+  if (!object.is_object()) {
+    found.errors.push_back(path + ": expected an object, got " + shown(object));
+    return;
+  }
   for (const Field& field : fields) {
     const auto it = object.find(field.key);
     if (it == object.end()) continue;
@@ -230,45 +241,51 @@ void check_fields(const json& object, const std::vector<Field>& fields, const st
     if (!has_kind(*it, field.kind)) {
       const std::string problem =
           where + ": expected " + kind_text(field.kind) + ", got " + shown(*it);
-      if (field.kind != Kind::Name) fail(name, problem);
-      warn += problem + " (ignored)\n";
+      (field.kind == Kind::Name ? found.warnings : found.errors).push_back(problem);
       continue;
     }
     if (field.length != 0 && it->size() != field.length) {
-      fail(name, where + ": expected " + std::to_string(field.length) + " numbers, got " +
-                     std::to_string(it->size()));
+      found.errors.push_back(where + ": expected " + std::to_string(field.length) +
+                             " numbers, got " + std::to_string(it->size()));
+      continue;
     }
-    if (field.fields != nullptr) check_fields(*it, *field.fields, where, name, warn);
+    if (field.fields != nullptr) check_fields(*it, *field.fields, where, found);
   }
 }
 
 /// The JSON types of every field covrast reads (tinygltf would skip a wrong one silently).
-void check_schema(const json& root, const std::string& name, std::string& warn) {
-  if (!root.is_object()) fail(name, "expected a JSON object at the top level");
+SchemaFindings check_schema(const json& root) {
+  SchemaFindings found;
+  if (!root.is_object()) {
+    found.errors.push_back("expected a JSON object at the top level");
+    return found;
+  }
   check_fields(root,
                {{"asset", Kind::Object},
                 {"scene", Kind::Index},
                 {"extensionsUsed", Kind::Array},
                 {"extensionsRequired", Kind::Array}},
-               "glTF", name, warn);
+               "glTF", found);
   for (const Section& section : sections()) {
     const auto it = root.find(section.key);
     if (it == root.end()) continue;
     if (!it->is_array()) {
-      fail(name, std::string(section.key) + ": expected an array, got " + shown(*it));
+      found.errors.push_back(std::string(section.key) + ": expected an array, got " + shown(*it));
+      continue;
     }
     for (std::size_t i = 0; i < it->size(); ++i) {
       const std::string path = std::string(section.key) + "[" + std::to_string(i) + "]";
-      check_fields((*it)[i], section.fields, path, name, warn);
-      if (std::strcmp(section.key, "meshes") != 0) continue;
+      check_fields((*it)[i], section.fields, path, found);
+      if (std::strcmp(section.key, "meshes") != 0 || !(*it)[i].is_object()) continue;
       const auto primitives = (*it)[i].find("primitives");
-      if (primitives == (*it)[i].end()) continue;
+      if (primitives == (*it)[i].end() || !primitives->is_array()) continue;
       for (std::size_t p = 0; p < primitives->size(); ++p) {
         check_fields((*primitives)[p], primitive_fields(),
-                     path + ".primitives[" + std::to_string(p) + "]", name, warn);
+                     path + ".primitives[" + std::to_string(p) + "]", found);
       }
     }
   }
+  return found;
 }
 
 /// Bytes that base64 text decodes to as tinygltf decodes it: up to the first byte outside
@@ -475,9 +492,30 @@ void check_gltf_input(std::string_view bytes, const std::string& name,
   } catch (const json::exception&) {
     return;  // a syntax error: tinygltf reports it with its line and column
   }
-  check_schema(root, name, warn);
+  const SchemaFindings found = check_schema(root);
+  if (!found.errors.empty()) fail(name, found.errors.front());
+  for (const std::string& warning : found.warnings) warn += warning + " (ignored)\n";
   check_buffers(root, name, base_dir);
   check_light_ranges(root, name, warn);
+}
+
+std::vector<std::string> gltf_schema_findings(std::string_view bytes, const std::string& name,
+                                              std::vector<std::string>& warnings) {
+  if (!is_glb(bytes) && bytes.find('{') == std::string_view::npos) return {};
+  json root;
+  try {
+    const std::string_view text = json_text(bytes, name);
+    std::size_t offset = 0;
+    if (!json_depth_within(text, kMaxJsonDepth, offset)) return {};
+    root = json::parse(text);
+  } catch (const std::exception&) {
+    return {};  // not glTF JSON: the load reports it
+  }
+  SchemaFindings found = check_schema(root);
+  for (std::string& warning : found.warnings)
+    warnings.push_back(name + ": " + warning + " (ignored)");
+  for (std::string& error : found.errors) error = name + ": " + error;
+  return found.errors;
 }
 
 tinygltf::FsCallbacks gltf_fs_callbacks() {

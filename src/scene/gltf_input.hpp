@@ -22,6 +22,12 @@ namespace covrast::detail {
 void check_gltf_input(std::string_view bytes, const std::string& name,
                       const std::filesystem::path& base_dir, std::string& warn);
 
+/// Every finding of check_gltf_input's type check, not only the first: the errors (returned)
+/// and the warnings (appended to `warnings`), each "name: JSON path: ...". Nothing for bytes
+/// that are not glTF JSON at all (the load reports that). For `covrast info --validate`.
+std::vector<std::string> gltf_schema_findings(std::string_view bytes, const std::string& name,
+                                              std::vector<std::string>& warnings);
+
 /// tinygltf's file access: FileExists without opening (a FIFO would block), no path
 /// expansion, ReadWholeFile through read_whole_file (regular files up to kMaxInputFileBytes).
 tinygltf::FsCallbacks gltf_fs_callbacks();

@@ -85,9 +85,7 @@ void check_obj_text(std::string_view text, const std::string& name) {
 
 std::shared_ptr<MeshData> load_mesh(const std::filesystem::path& path) {
   const std::string name = path.string();
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(path);
   if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
     throw InputError(name + ": unknown mesh format (expected .obj, .gltf or .glb)");
   }

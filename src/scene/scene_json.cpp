@@ -1133,9 +1133,7 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
 Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int height,
                       const SceneChoices& choices) {
   const std::string file = mesh_path.string();
-  std::string ext = mesh_path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = detail::lower_extension(mesh_path);
   if (ext != ".obj" && ext != ".gltf" && ext != ".glb") {
     throw InputError(file + ": unknown mesh format (expected .obj, .gltf or .glb)");
   }
