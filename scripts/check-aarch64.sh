@@ -44,8 +44,8 @@ trap 'rm -rf "$out"' EXIT
 pairs=0
 differ=0
 bytes_differ=0
-render_pair() {  # scene mode size
-  local name="$1-${2//:/_}-$3"
+render_pair() {  # scene (under scenes/, without .json) mode size
+  local name="${1//[\/.]/_}-${2//:/_}-$3"
   local x86="$out/$name-x86.png"
   [[ -f "$x86" ]] || "$x86_bin" render "scenes/$1.json" -o "$x86" --mode "$2" --size "$3" --quiet
   local arm="$out/$name-arm.png"
@@ -77,12 +77,17 @@ for cpu in "${cpus[@]}"; do
     render_pair lit reference 48x27
     # Image-based lighting and tone mapping: libm's sin, cos, acos, atan2 and log2 on both.
     render_pair studio coverage 160x90
+    # The glTF material extensions' layers (clear coat, sheen: libm's pow and exp).
+    render_pair ../docs/scenes/clearcoat coverage 160x60
+    render_pair ../docs/scenes/sheen coverage 160x90
   else
     for scene in default boxes slivers near_plane lit overlap sphere_closed studio; do
       for mode in "${modes[@]}"; do render_pair "$scene" "$mode" 160x90; done
     done
     render_pair default reference 48x27
     render_pair lit reference 48x27
+    render_pair ../docs/scenes/clearcoat coverage 160x60
+    render_pair ../docs/scenes/sheen coverage 160x90
   fi
 done
 echo "aarch64 vs x86-64: $pairs image pairs, $differ differ in pixels," \

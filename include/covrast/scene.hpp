@@ -117,6 +117,13 @@ struct Material {
   TextureSlot clearcoat_texture;
   TextureSlot clearcoat_roughness_texture;
   TextureSlot clearcoat_normal_texture;  ///< scale as normal_texture's
+  /// KHR_materials_sheen: the sheen of fabrics, a "Charlie" lobe (Conty Estevez and Kulla 2017)
+  /// over the material, which it dims by the sheen's albedo; colour (linear, 0..1; x the
+  /// texture's RGB, sRGB texels; black: no sheen) and roughness (0..1; x the texture's A).
+  glm::vec3 sheen_color_factor{0.0f};
+  float sheen_roughness = 0.0f;
+  TextureSlot sheen_color_texture;  ///< sRGB texels
+  TextureSlot sheen_roughness_texture;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
@@ -127,11 +134,11 @@ struct Material {
   std::string base_color_texture_path;
 
   /// Every texture slot, in one order (for checks and listings that treat them alike).
-  std::array<const TextureSlot*, 10> texture_slots() const {
-    return {&base_color_texture,      &metallic_roughness_texture, &normal_texture,
-            &occlusion_texture,       &emissive_texture,           &specular_texture,
-            &specular_color_texture,  &clearcoat_texture,          &clearcoat_roughness_texture,
-            &clearcoat_normal_texture};
+  std::array<const TextureSlot*, 12> texture_slots() const {
+    return {&base_color_texture,       &metallic_roughness_texture, &normal_texture,
+            &occlusion_texture,        &emissive_texture,           &specular_texture,
+            &specular_color_texture,   &clearcoat_texture,          &clearcoat_roughness_texture,
+            &clearcoat_normal_texture, &sheen_color_texture,        &sheen_roughness_texture};
   }
 };
 

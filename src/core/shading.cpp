@@ -7,6 +7,7 @@
 #include "core/environment_lighting.hpp"
 #include "core/pbr_terms.hpp"
 #include "core/shading_inputs.hpp"
+#include "core/sheen.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -158,12 +159,50 @@ glm::dvec3 clearcoat_radiance(const SurfaceShading& s, const PbrPoint& m, const 
   return sum;
 }
 
-/// The glTF material at a point, coated (KHR_materials_clearcoat, "fresnel_coat"):
+/// KHR_materials_sheen's layer (core/sheen.hpp): sheenColor x (sum_i D V E_i (n . l_i)+ plus
+/// the ambient light and the environment (without its suns, lit as the directional lights they
+/// are) each times the sheen's albedo E(n . v) and occlusion): the environment's cosine-
+/// weighted mean radiance E_env(n) / pi stands for the radiance the broad sheen lobe gathers,
+/// exact for a uniform environment (docs/shading.md gives the error against quadrature).
+glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
+                          const glm::dvec3& n, const glm::dvec3& v) {
+  const double albedo = sheen_albedo(glm::dot(n, v), m.sheen_roughness);
+  glm::dvec3 sum = s.context->ambient * (s.occlusion * albedo);
+  for (const PunctualLight& light : s.context->lights) {
+    const Incident in = incident(light, p);
+    const double n_dot_l = glm::dot(n, in.l);
+    if (!(n_dot_l > 0.0)) continue;
+    sum += in.irradiance * (sheen_lobe(n, v, in.l, m.sheen_roughness) * n_dot_l);
+  }
+  if (const EnvironmentLighting* environment = s.context->environment) {
+    sum +=
+        environment->integrals(n, v, m.sheen_roughness).irradiance * (s.occlusion * albedo / kPi);
+    for (const EnvironmentSun& sun : environment->suns()) {
+      const double n_dot_l = glm::dot(n, sun.to_light);
+      if (!(n_dot_l > 0.0)) continue;
+      sum += sun.irradiance *
+             (sheen_lobe(n, v, sun.to_light, m.sheen_roughness) * n_dot_l * s.occlusion);
+    }
+  }
+  return m.sheen_color * sum;
+}
+
+/// The glTF material at a point, with its sheen (KHR_materials_sheen, albedo scaling):
+///   L = L_sheen + L_base (1 - max(sheenColor) E(n . v)) + emission,
+/// coated (KHR_materials_clearcoat, "fresnel_coat"):
 ///   L = L_base (1 - clearcoat Fc) + clearcoat Fc L_coat,  Fc = 0.04 + 0.96 (1 - |n_c . v|)^5,
 /// L_base with the emission (the coat darkens it too).
 glm::dvec3 pbr_shade(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
                      const glm::dvec3& n, const glm::dvec3& v) {
-  const glm::dvec3 base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
+  glm::dvec3 base;
+  if (m.sheen_color == glm::dvec3(0.0) || n == glm::dvec3(0.0)) {
+    base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
+  } else {
+    const double strongest = std::max({m.sheen_color.r, m.sheen_color.g, m.sheen_color.b});
+    const double scaling = 1.0 - strongest * sheen_albedo(glm::dot(n, v), m.sheen_roughness);
+    base = (pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v)) * scaling +
+           sheen_radiance(s, m, p, n, v) + s.emissive;
+  }
   if (!(m.clearcoat > 0.0)) return base;
   const double coat = m.clearcoat * clearcoat_fresnel(m.coat_normal, v);
   return base * (1.0 - coat) + clearcoat_radiance(s, m, p, v) * coat;
@@ -207,7 +246,9 @@ PbrPoint::PbrPoint(const SurfaceShading& s, const glm::dvec3& base_color,
       roughness(s.roughness),
       clearcoat(s.clearcoat),
       coat_roughness(s.clearcoat_roughness),
-      coat_normal(clearcoat_normal) {
+      coat_normal(clearcoat_normal),
+      sheen_color(s.sheen_color),
+      sheen_roughness(s.sheen_roughness) {
   // Dielectric F0 = min(f0(ior) x specular colour, 1) x specular, F90 = specular; each then
   // lerped towards the metal's (base, 1) by metallic. At the defaults (f0 0.04, colour 1,
   // specular 1) this is the core material's F0 = lerp(0.04, base, metallic), F90 = 1, bit for bit.
@@ -301,6 +342,8 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   s.specular_color = sample.specular_color;
   s.clearcoat = sample.clearcoat;
   s.clearcoat_roughness = sample.clearcoat_roughness;
+  s.sheen_color = sample.sheen_color;
+  s.sheen_roughness = sample.sheen_roughness;
   return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
                             sample.clearcoat_normal));
 }

@@ -63,6 +63,8 @@ struct SurfaceTextures {
   const TextureSlot* clearcoat = nullptr;            ///< KHR_materials_clearcoat, R
   const TextureSlot* clearcoat_roughness = nullptr;  ///< KHR_materials_clearcoat, G
   const TextureSlot* clearcoat_normal = nullptr;
+  const TextureSlot* sheen_color = nullptr;      ///< KHR_materials_sheen, RGB
+  const TextureSlot* sheen_roughness = nullptr;  ///< KHR_materials_sheen, A
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -85,6 +87,9 @@ struct SurfaceShading {
   /// pbr, KHR_materials_clearcoat: the coat's weight (0: none) and perceptual roughness.
   double clearcoat = 0.0;
   double clearcoat_roughness = 0.0;
+  /// pbr, KHR_materials_sheen: the sheen's colour (0: none) and perceptual roughness.
+  glm::dvec3 sheen_color{0.0};
+  double sheen_roughness = 0.0;
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
@@ -128,6 +133,8 @@ struct SurfaceSample {
   double clearcoat_roughness = 0.0;  ///< the surface's, times the roughness texture's G
   /// unit, world space: the clearcoat normal texture applied, else the interpolated normal
   glm::dvec3 clearcoat_normal{0.0};
+  glm::dvec3 sheen_color{0.0};   ///< the surface's, times the sheen colour texture
+  double sheen_roughness = 0.0;  ///< the surface's, times the sheen roughness texture's A
 };
 
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
@@ -171,6 +178,8 @@ struct PbrPoint {
   double clearcoat;
   double coat_roughness;
   glm::dvec3 coat_normal;
+  glm::dvec3 sheen_color;
+  double sheen_roughness;
 };
 
 /// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-

@@ -79,9 +79,10 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
   return m_length > 0.0 ? m / m_length : n;
 }
 
-/// The textures of KHR_materials_specular (strength in A, F0 colour in RGB) and
-/// KHR_materials_clearcoat (weight in R, roughness in G, its own normal map, which perturbs the
-/// interpolated normal, not the base's mapped one); each multiplies the surface's factor.
+/// The textures of KHR_materials_specular (strength in A, F0 colour in RGB),
+/// KHR_materials_sheen (colour in RGB, roughness in A) and KHR_materials_clearcoat (weight in R,
+/// roughness in G, its own normal map, which perturbs the interpolated normal, not the base's
+/// mapped one); each multiplies the surface's factor.
 void sample_material_extensions(const SurfaceTextures& slots, const TexturedCorners& corners,
                                 const double mu[3], const WeightDerivatives& d,
                                 SurfaceSample& out) {
@@ -92,6 +93,12 @@ void sample_material_extensions(const SurfaceTextures& slots, const TexturedCorn
   if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d).r;
   if (slots.clearcoat_roughness != nullptr) {
     out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d).g;
+  }
+  if (slots.sheen_color != nullptr) {
+    out.sheen_color *= glm::dvec3(lookup(*slots.sheen_color, corners, mu, d));
+  }
+  if (slots.sheen_roughness != nullptr) {
+    out.sheen_roughness *= lookup(*slots.sheen_roughness, corners, mu, d).a;
   }
   if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
     out.clearcoat_normal =
@@ -127,6 +134,8 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.clearcoat = s.clearcoat;
   out.clearcoat_roughness = s.clearcoat_roughness;
   out.clearcoat_normal = normal;
+  out.sheen_color = s.sheen_color;
+  out.sheen_roughness = s.sheen_roughness;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
   if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d);

@@ -285,6 +285,8 @@ SurfaceTextures surface_textures(const Material& m, bool lit) {
   out.clearcoat = slot(m.clearcoat_texture);
   out.clearcoat_roughness = slot(m.clearcoat_roughness_texture);
   out.clearcoat_normal = slot(m.clearcoat_normal_texture);
+  out.sheen_color = slot(m.sheen_color_texture);
+  out.sheen_roughness = slot(m.sheen_roughness_texture);
   return out;
 }
 
@@ -292,7 +294,8 @@ bool any_texture(const SurfaceTextures& t) {
   return t.base_color != nullptr || t.metallic_roughness != nullptr || t.normal != nullptr ||
          t.occlusion != nullptr || t.emissive != nullptr || t.specular != nullptr ||
          t.specular_color != nullptr || t.clearcoat != nullptr ||
-         t.clearcoat_roughness != nullptr || t.clearcoat_normal != nullptr;
+         t.clearcoat_roughness != nullptr || t.clearcoat_normal != nullptr ||
+         t.sheen_color != nullptr || t.sheen_roughness != nullptr;
 }
 
 /// Whether some instance shows a texture: an unlit scene then needs the shaded path too.
@@ -326,6 +329,8 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.specular_color = glm::dvec3(m.specular_color_factor);
   s.clearcoat = m.clearcoat;
   s.clearcoat_roughness = m.clearcoat_roughness;
+  s.sheen_color = glm::dvec3(m.sheen_color_factor);
+  s.sheen_roughness = m.sheen_roughness;
   return s;
 }
 

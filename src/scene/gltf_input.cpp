@@ -65,6 +65,7 @@ const std::vector<Field> kMaterialExtensionFields = {
     {"KHR_materials_ior", Kind::Object},
     {"KHR_materials_specular", Kind::Object},
     {"KHR_materials_clearcoat", Kind::Object},
+    {"KHR_materials_sheen", Kind::Object},
     {"KHR_materials_emissive_strength", Kind::Object},
     {"KHR_materials_unlit", Kind::Object}};
 

@@ -90,6 +90,31 @@ void read_clearcoat(const ExtensionObject& e, const std::string& name, GltfTextu
   m.clearcoat_normal_texture = texture(e, "clearcoatNormalTexture", false, textures);
 }
 
+/// Three numbers in [0, 1] (sheenColorFactor) into `out`, which keeps its value when absent.
+void read_unit_color(const ExtensionObject& e, const char* key, const std::string& name,
+                     glm::vec3& out) {
+  if (!e.value->Has(key)) return;
+  const tinygltf::Value& a = e.value->Get(key);
+  bool ok = a.IsArray() && a.ArrayLen() == 3;
+  for (int c = 0; ok && c < 3; ++c) {
+    const tinygltf::Value& v = a.Get(c);
+    const double x = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+    ok = x >= 0.0 && x <= 1.0;
+    if (ok) out[c] = static_cast<float>(x);
+  }
+  if (!ok) fail(name, e.path + "." + key + ": expected an array of 3 numbers in 0..1");
+}
+
+/// KHR_materials_sheen: sheenColorFactor (three numbers in 0..1, linear, default black: no
+/// sheen), sheenColorTexture (RGB, sRGB), sheenRoughnessFactor (0..1) and its texture (A).
+void read_sheen(const ExtensionObject& e, const std::string& name, GltfTextures& textures,
+                Material& m) {
+  read_unit_color(e, "sheenColorFactor", name, m.sheen_color_factor);
+  m.sheen_roughness = static_cast<float>(number_in(e, "sheenRoughnessFactor", 0.0, 0.0, 1.0, name));
+  m.sheen_color_texture = texture(e, "sheenColorTexture", true, textures);
+  m.sheen_roughness_texture = texture(e, "sheenRoughnessTexture", false, textures);
+}
+
 }  // namespace
 
 void read_material_extensions(const tinygltf::Material& source, int index, GltfTextures& textures,
@@ -103,6 +128,9 @@ void read_material_extensions(const tinygltf::Material& source, int index, GltfT
   }
   if (const ExtensionObject e = find_extension(source, index, kClearcoatExtension, name); e.value) {
     read_clearcoat(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kSheenExtension, name); e.value) {
+    read_sheen(e, name, textures, m);
   }
 }
 

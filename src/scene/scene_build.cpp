@@ -71,6 +71,14 @@ void check_material(const Material& m, const std::string& what) {
     fail(what, "specular_color_factor must be finite and >= 0");
   }
   if (!(m.clearcoat >= 0.0f && m.clearcoat <= 1.0f)) fail(what, "clearcoat must be in 0..1");
+  for (int c = 0; c < 3; ++c) {
+    if (!(m.sheen_color_factor[c] >= 0.0f && m.sheen_color_factor[c] <= 1.0f)) {
+      fail(what, "sheen_color_factor must be in 0..1");
+    }
+  }
+  if (!(m.sheen_roughness >= 0.0f && m.sheen_roughness <= 1.0f)) {
+    fail(what, "sheen_roughness must be in 0..1");
+  }
   if (!(m.clearcoat_roughness >= 0.0f && m.clearcoat_roughness <= 1.0f)) {
     fail(what, "clearcoat_roughness must be in 0..1");
   }

@@ -388,7 +388,8 @@ class SceneReader {
          "expected \"unlit\", \"lambert\", \"blinn-phong\" or \"pbr\", got " + shown(value));
   }
 
-  /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat).
+  /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat,
+  /// _sheen).
   void apply_material_extensions(const json& object, const std::string& key, Material& m) const {
     if (const auto it = object.find("ior"); it != object.end()) {
       const double ior = number_in(*it, key + ".ior", 0.0, 1e6);
@@ -402,6 +403,12 @@ class SceneReader {
     }
     if (const auto it = object.find("clearcoat"); it != object.end()) {
       m.clearcoat = static_cast<float>(number_in(*it, key + ".clearcoat", 0.0, 1.0));
+    }
+    if (const auto it = object.find("sheen_color"); it != object.end()) {
+      m.sheen_color_factor = srgb_color(*it, key + ".sheen_color");
+    }
+    if (const auto it = object.find("sheen_roughness"); it != object.end()) {
+      m.sheen_roughness = static_cast<float>(number_in(*it, key + ".sheen_roughness", 0.0, 1.0));
     }
     if (const auto it = object.find("clearcoat_roughness"); it != object.end()) {
       m.clearcoat_roughness =
