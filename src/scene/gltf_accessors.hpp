@@ -33,6 +33,12 @@ std::optional<int> whole_number(const tinygltf::Value& value, int lo, int hi);
 /// A number for a message: as short as it prints ("3", "1e+30", "-1.5").
 std::string number_text(double value);
 
+/// A factor of the file clamped to [0, 1] as a float (NaN becomes 0).
+inline float clamp_unit(double value) {
+  if (!(value > 0.0)) return 0.0f;  // also NaN
+  return value >= 1.0 ? 1.0f : static_cast<float>(value);
+}
+
 /// The accessors of `model`, read for messages that start with `name` (the file).
 struct GltfReader {
   const tinygltf::Model& model;

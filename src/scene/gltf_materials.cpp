@@ -1,4 +1,5 @@
-// The glTF material extensions of the pbr material (gltf_materials.hpp).
+// The glTF reader's materials (gltf_materials.hpp): the core factors, the textures
+// (GltfTextures) and the extensions of the pbr material.
 #include "scene/gltf_materials.hpp"
 
 #include "scene/gltf_accessors.hpp"
@@ -6,6 +7,7 @@
 
 #include <tiny_gltf.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -115,7 +117,76 @@ void read_sheen(const ExtensionObject& e, const std::string& name, GltfTextures&
   m.sheen_roughness_texture = texture(e, "sheenRoughnessTexture", false, textures);
 }
 
+/// A number of an extension object ("emissiveStrength" of KHR_materials_emissive_strength),
+/// or `fallback`.
+double extension_number(const tinygltf::ExtensionMap& extensions, const char* extension,
+                        const char* key, double fallback) {
+  const auto it = extensions.find(extension);
+  if (it == extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
+  const tinygltf::Value& value = it->second.Get(key);
+  return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
+}
+
+/// A glTF material's factors as covrast shades them (glTF 2.0, 3.9 and 5.19; the textures
+/// come from GltfTextures::apply): pbrMetallicRoughness' metallic and roughness factors,
+/// emissiveFactor x KHR_materials_emissive_strength, doubleSided; KHR_materials_unlit selects
+/// ShadingModel::Unlit. The base colour factor goes into the colour selection, as unlit.
+Material convert_material(const tinygltf::Material& source) {
+  Material m;
+  m.model =
+      source.extensions.count("KHR_materials_unlit") != 0 ? ShadingModel::Unlit : ShadingModel::Pbr;
+  m.metallic = clamp_unit(source.pbrMetallicRoughness.metallicFactor);
+  m.roughness = clamp_unit(source.pbrMetallicRoughness.roughnessFactor);
+  const double strength = extension_number(source.extensions, "KHR_materials_emissive_strength",
+                                           "emissiveStrength", 1.0);
+  const double scale = std::isfinite(strength) && strength > 0.0 ? strength : 0.0;
+  if (source.emissiveFactor.size() == 3) {
+    for (int c = 0; c < 3; ++c) {
+      m.emissive_linear[c] =
+          static_cast<float>(clamp_unit(source.emissiveFactor[std::size_t(c)]) * scale);
+    }
+  }
+  m.double_sided = source.doubleSided;
+  // alphaMode, alphaCutoff and baseColorFactor's alpha (3.9.4); GltfMeshBuilder refuses other
+  // modes (tinygltf's default is "OPAQUE").
+  m.alpha_mode = source.alphaMode == "MASK"    ? AlphaMode::Mask
+                 : source.alphaMode == "BLEND" ? AlphaMode::Blend
+                                               : AlphaMode::Opaque;
+  // In double, as the file gives them (a cutoff of 0.3 stays 0.3); NaN becomes 0.
+  const auto unit = [](double v) { return v >= 0.0 ? std::min(v, 1.0) : 0.0; };
+  m.alpha_cutoff = unit(source.alphaCutoff);
+  const std::vector<double>& factor = source.pbrMetallicRoughness.baseColorFactor;
+  if (factor.size() == 4) m.base_alpha = unit(factor[3]);
+  return m;
+}
+
 }  // namespace
+
+std::vector<Material> read_materials(const tinygltf::Model& model, GltfTextures& textures,
+                                     std::vector<std::string>& warnings) {
+  const std::string& name = textures.file_name();
+  std::vector<Material> materials;
+  for (std::size_t i = 0; i < model.materials.size(); ++i) {
+    const std::string& mode = model.materials[i].alphaMode;
+    if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND") {
+      fail(name, "material " + std::to_string(i) + ": alphaMode \"" + mode +
+                     "\" is not OPAQUE, MASK or BLEND");
+    }
+    // glTF 2.0, 5.19: alphaCutoff >= 0. Used in MASK mode: an error; else ignored: a
+    // warning (issue 28: -1 was taken as 0).
+    if (const double cutoff = model.materials[i].alphaCutoff; !(cutoff >= 0.0)) {
+      const std::string message = "material " + std::to_string(i) + ": alphaCutoff " +
+                                  number_text(cutoff) + " must be >= 0";
+      if (mode == "MASK") fail(name, message);
+      warnings.push_back(name + ": " + message + " (ignored: alphaMode is " + mode + ")");
+    }
+    materials.push_back(convert_material(model.materials[i]));
+    textures.apply(model.materials[i], int(i), materials.back());
+    read_material_extensions(model.materials[i], int(i), textures, materials.back());
+  }
+  materials.push_back(convert_material(tinygltf::Material{}));
+  return materials;
+}
 
 void read_material_extensions(const tinygltf::Material& source, int index, GltfTextures& textures,
                               Material& m) {

@@ -1,16 +1,20 @@
-// The glTF material extensions that change the pbr material (docs/shading.md, "Material
-// extensions"), read for the glTF reader (mesh_gltf.cpp) as their specifications in
+// The glTF reader's materials (mesh_gltf.cpp): the core material's factors and textures, and
+// the material extensions that change the pbr material (docs/shading.md, "Material
+// extensions"), read as their specifications in
 // KhronosGroup/glTF, extensions/2.0/Khronos/, define them: KHR_materials_ior, _specular,
 // _clearcoat and _sheen.
 #pragma once
 
 #include <covrast/scene.hpp>
 
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace tinygltf {
+class Model;
 struct Material;
-}
+}  // namespace tinygltf
 
 namespace covrast::detail {
 
@@ -20,6 +24,14 @@ inline constexpr std::string_view kIorExtension = "KHR_materials_ior";
 inline constexpr std::string_view kSpecularExtension = "KHR_materials_specular";
 inline constexpr std::string_view kClearcoatExtension = "KHR_materials_clearcoat";
 inline constexpr std::string_view kSheenExtension = "KHR_materials_sheen";
+
+/// The file's materials as covrast shades them, in file order, then glTF's default material
+/// (for primitives without one): each material's factors (glTF 2.0, 3.9 and 5.19), textures
+/// (`textures`) and extensions. An alphaMode other than OPAQUE, MASK and BLEND, or a negative
+/// alphaCutoff in MASK mode, is an InputError; a negative alphaCutoff otherwise a line of
+/// `warnings`.
+std::vector<Material> read_materials(const tinygltf::Model& model, GltfTextures& textures,
+                                     std::vector<std::string>& warnings);
 
 /// Sets `m`'s extension fields and texture slots from material `index`'s extensions. Every
 /// value is checked for type and range as the extensions' schemas give them; a wrong one is

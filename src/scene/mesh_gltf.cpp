@@ -121,54 +121,6 @@ glm::dmat4 local_transform(const tinygltf::Node& node, const std::string& name, 
   return t * r * s;
 }
 
-float clamp_unit(double value) {
-  if (!(value > 0.0)) return 0.0f;  // also NaN
-  return value >= 1.0 ? 1.0f : static_cast<float>(value);
-}
-
-/// A number of an extension object ("emissiveStrength" of KHR_materials_emissive_strength),
-/// or `fallback`.
-double extension_number(const tinygltf::ExtensionMap& extensions, const char* extension,
-                        const char* key, double fallback) {
-  const auto it = extensions.find(extension);
-  if (it == extensions.end() || !it->second.IsObject() || !it->second.Has(key)) return fallback;
-  const tinygltf::Value& value = it->second.Get(key);
-  return value.IsNumber() ? value.GetNumberAsDouble() : fallback;
-}
-
-/// A glTF material's factors as covrast shades them (glTF 2.0, 3.9 and 5.19; the textures
-/// come from GltfTextures::apply): pbrMetallicRoughness' metallic and roughness factors,
-/// emissiveFactor x KHR_materials_emissive_strength, doubleSided; KHR_materials_unlit selects
-/// ShadingModel::Unlit. The base colour factor goes into the colour selection, as unlit.
-Material convert_material(const tinygltf::Material& source) {
-  Material m;
-  m.model =
-      source.extensions.count("KHR_materials_unlit") != 0 ? ShadingModel::Unlit : ShadingModel::Pbr;
-  m.metallic = clamp_unit(source.pbrMetallicRoughness.metallicFactor);
-  m.roughness = clamp_unit(source.pbrMetallicRoughness.roughnessFactor);
-  const double strength = extension_number(source.extensions, "KHR_materials_emissive_strength",
-                                           "emissiveStrength", 1.0);
-  const double scale = std::isfinite(strength) && strength > 0.0 ? strength : 0.0;
-  if (source.emissiveFactor.size() == 3) {
-    for (int c = 0; c < 3; ++c) {
-      m.emissive_linear[c] =
-          static_cast<float>(clamp_unit(source.emissiveFactor[std::size_t(c)]) * scale);
-    }
-  }
-  m.double_sided = source.doubleSided;
-  // alphaMode, alphaCutoff and baseColorFactor's alpha (3.9.4); GltfMeshBuilder refuses other
-  // modes (tinygltf's default is "OPAQUE").
-  m.alpha_mode = source.alphaMode == "MASK"    ? AlphaMode::Mask
-                 : source.alphaMode == "BLEND" ? AlphaMode::Blend
-                                               : AlphaMode::Opaque;
-  // In double, as the file gives them (a cutoff of 0.3 stays 0.3); NaN becomes 0.
-  const auto unit = [](double v) { return v >= 0.0 ? std::min(v, 1.0) : 0.0; };
-  m.alpha_cutoff = unit(source.alphaCutoff);
-  const std::vector<double>& factor = source.pbrMetallicRoughness.baseColorFactor;
-  if (factor.size() == 4) m.base_alpha = unit(factor[3]);
-  return m;
-}
-
 /// A glTF camera's projection (glTF 2.0, 3.10.2); aspectRatio is not kept: the image's
 /// width and height decide it.
 FileCamera file_camera(const tinygltf::Camera& camera) {
@@ -355,25 +307,7 @@ class GltfMeshBuilder {
     // The file's materials with their textures (each image decoded once), then glTF's default
     // material for primitives without one.
     GltfTextures textures(model, reader_, base_dir, warnings_);
-    for (std::size_t i = 0; i < model.materials.size(); ++i) {
-      const std::string& mode = model.materials[i].alphaMode;
-      if (mode != "OPAQUE" && mode != "MASK" && mode != "BLEND") {
-        fail(name, "material " + std::to_string(i) + ": alphaMode \"" + mode +
-                       "\" is not OPAQUE, MASK or BLEND");
-      }
-      // glTF 2.0, 5.19: alphaCutoff >= 0. Used in MASK mode: an error; else ignored: a
-      // warning (issue 28: -1 was taken as 0).
-      if (const double cutoff = model.materials[i].alphaCutoff; !(cutoff >= 0.0)) {
-        const std::string message = "material " + std::to_string(i) + ": alphaCutoff " +
-                                    number_text(cutoff) + " must be >= 0";
-        if (mode == "MASK") fail(name, message);
-        warnings_.push_back(name + ": " + message + " (ignored: alphaMode is " + mode + ")");
-      }
-      mesh_->materials.push_back(convert_material(model.materials[i]));
-      textures.apply(model.materials[i], int(i), mesh_->materials.back());
-      read_material_extensions(model.materials[i], int(i), textures, mesh_->materials.back());
-    }
-    mesh_->materials.push_back(convert_material(tinygltf::Material{}));
+    mesh_->materials = read_materials(model, textures, warnings_);
     default_material_ = static_cast<std::uint32_t>(model.materials.size());
     mesh_->material_variants = material_variant_names(model, name);
     if (!variant.empty()) {
