@@ -265,6 +265,8 @@ class GeometryFrontEnd {
   /// Builds context_, surfaces_, lit_ and alpha_ from the scene (constructor: lit scenes,
   /// scenes with textures and scenes with non-opaque materials only).
   void prepare_lighting();
+  /// Whether some instance shows a texture: an unlit scene then needs the shaded path too.
+  static bool shows_textures(const Scene& scene);
   /// Which facing of an instance to drop this frame (Sink::drop_facing).
   unsigned drop_facing(std::size_t instance) const;
   /// Whether an instance's triangles are of a convex surface
