@@ -77,9 +77,10 @@ for cpu in "${cpus[@]}"; do
     render_pair lit reference 48x27
     # Image-based lighting and tone mapping: libm's sin, cos, acos, atan2 and log2 on both.
     render_pair studio coverage 160x90
-    # The glTF material extensions' layers (clear coat, sheen: libm's pow and exp).
+    # The glTF material extensions' layers (clear coat, sheen, thin film: libm's pow, exp, cos).
     render_pair ../docs/scenes/clearcoat coverage 160x60
     render_pair ../docs/scenes/sheen coverage 160x90
+    render_pair ../docs/scenes/iridescence coverage 160x60
   else
     for scene in default boxes slivers near_plane lit overlap sphere_closed studio; do
       for mode in "${modes[@]}"; do render_pair "$scene" "$mode" 160x90; done
@@ -88,6 +89,7 @@ for cpu in "${cpus[@]}"; do
     render_pair lit reference 48x27
     render_pair ../docs/scenes/clearcoat coverage 160x60
     render_pair ../docs/scenes/sheen coverage 160x90
+    render_pair ../docs/scenes/iridescence coverage 160x60
   fi
 done
 echo "aarch64 vs x86-64: $pairs image pairs, $differ differ in pixels," \

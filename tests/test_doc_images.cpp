@@ -68,4 +68,6 @@ TEST_CASE("docs: the pictures show what this build renders", "[docs]") {
         render_scene("docs/scenes/clearcoat.json", "coverage").rgb);
   CHECK(covrast::read_png(images / "sheen.png").rgb ==
         render_scene("docs/scenes/sheen.json", "coverage").rgb);
+  CHECK(covrast::read_png(images / "iridescence.png").rgb ==
+        render_scene("docs/scenes/iridescence.json", "coverage").rgb);
 }

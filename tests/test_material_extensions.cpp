@@ -97,6 +97,53 @@ struct SheenAlbedo {
   std::array<double, 129> table{};
 };
 
+/// KHR_materials_iridescence's thin-film Fresnel term, written out from the extension's
+/// implementation notes (Belcour and Barla 2017; OPD with cos theta2, as the extension's
+/// current text and the Khronos viewers have it).
+glm::dvec3 thin_film(double film_ior, const glm::dvec3& base_f0, double thickness, double cos1) {
+  const auto f0_of = [](double t, double i) { return std::pow((t - i) / (t + i), 2.0); };
+  const auto schlick = [](double f0, double c) { return f0 + (1.0 - f0) * std::pow(1.0 - c, 5.0); };
+  const double sin2 = std::pow(1.0 / film_ior, 2.0) * (1.0 - cos1 * cos1);
+  if (1.0 - sin2 < 0.0) return glm::dvec3(1.0);
+  const double cos2 = std::sqrt(1.0 - sin2);
+  const double r12 = schlick(f0_of(film_ior, 1.0), cos1), t121 = 1.0 - r12;
+  const double phi21 = kPi - (film_ior < 1.0 ? kPi : 0.0);
+  const double opd = 2.0 * film_ior * thickness * cos2;
+  glm::dvec3 out;
+  for (int c = 0; c < 3; ++c) {
+    const double sq = std::sqrt(std::clamp(base_f0[c], 0.0, 0.9999));
+    const double base_ior = (1.0 + sq) / (1.0 - sq);
+    const double r23 = schlick(f0_of(base_ior, film_ior), cos2);
+    const double phi = phi21 + (base_ior < film_ior ? kPi : 0.0);
+    const double r123 = std::clamp(r12 * r23, 1e-5, 0.9999);
+    const double rs = t121 * t121 * r23 / (1.0 - r123);
+    double value = r12 + rs, cm = rs - t121;
+    for (int m = 1; m <= 2; ++m) {
+      cm *= std::sqrt(r123);
+      // The sensitivity in XYZ (Gaussian fits), then its row of XYZ -> linear Rec. 709.
+      const double ph = 2.0 * kPi * (m * opd) * 1e-9, shift = m * phi;
+      const double val[3] = {5.4856e-13, 4.4201e-13, 5.2481e-13};
+      const double pos[3] = {1.6810e+06, 1.7953e+06, 2.2084e+06};
+      const double var[3] = {4.3278e+09, 9.3046e+09, 6.6121e+09};
+      double xyz[3];
+      for (int k = 0; k < 3; ++k) {
+        xyz[k] = val[k] * std::sqrt(2.0 * kPi * var[k]) * std::cos(pos[k] * ph + shift) *
+                 std::exp(-ph * ph * var[k]);
+      }
+      xyz[0] += 9.7470e-14 * std::sqrt(2.0 * kPi * 4.5282e+09) * std::cos(2.2399e+06 * ph + shift) *
+                std::exp(-4.5282e+09 * ph * ph);
+      for (double& x : xyz) x /= 1.0685e-7;
+      const double rows[3][3] = {{3.2404542, -1.5371385, -0.4985314},
+                                 {-0.9692660, 1.8760108, 0.0415560},
+                                 {0.0556434, -0.2040259, 1.0572252}};
+      const double rgb = rows[c][0] * xyz[0] + rows[c][1] * xyz[1] + rows[c][2] * xyz[2];
+      value += cm * 2.0 * rgb;
+    }
+    out[c] = std::max(value, 0.0);
+  }
+  return out;
+}
+
 /// The lit sphere's sun and sky.
 const glm::dvec3 kSunDirection = glm::normalize(glm::dvec3(-0.3, -0.4, -1.0));
 constexpr double kSun = 2.0, kSky = 0.1;
@@ -128,16 +175,34 @@ glm::dvec3 extended_pbr(const Material& m, const glm::dvec3& base, const glm::dv
     f_d[c] = f0_d[c] + (spec - f0_d[c]) * s;
   }
   const double max_f0_d = std::max({f0_d.r, f0_d.g, f0_d.b});
-  const double max_f_d = std::max({f_d.r, f_d.g, f_d.b});
   const double alpha = std::max(double(m.roughness) * m.roughness, 1e-3);
   const double dv = ggx_d(alpha, n_h) * smith_v(alpha, n_l, n_v, h_l, h_v);
+  // KHR_materials_iridescence: dielectric = rgb_mix(diffuse, specular, mix(F_d, Ir_d, k)),
+  // metal = specular x mix(F_m, Ir_m, k), Ir at n . v over F0_d and over the base.
+  const double k = m.iridescence;
+  const glm::dvec3 ir_d =
+      k > 0.0 ? thin_film(m.iridescence_ior, f0_d, m.iridescence_thickness_max_nm, std::abs(n_v))
+              : glm::dvec3(0.0);
+  const glm::dvec3 ir_m =
+      k > 0.0 ? thin_film(m.iridescence_ior, base, m.iridescence_thickness_max_nm, std::abs(n_v))
+              : glm::dvec3(0.0);
+  glm::dvec3 mix_d, mix_m;
+  for (int c = 0; c < 3; ++c) {
+    mix_d[c] = f_d[c] * (1.0 - k) + ir_d[c] * k;
+    mix_m[c] = (base[c] + (1.0 - base[c]) * s) * (1.0 - k) + ir_m[c] * k;
+  }
+  const double max_mix_d = std::max({mix_d.r, mix_d.g, mix_d.b});
+  const double max_ir_d = std::max({ir_d.r, ir_d.g, ir_d.b});
   glm::dvec3 out;
   for (int c = 0; c < 3; ++c) {
-    const double dielectric = (1.0 - max_f_d) * base[c] / kPi + f_d[c] * dv;
-    const double metal = (base[c] + (1.0 - base[c]) * s) * dv;
+    const double dielectric = (1.0 - max_mix_d) * base[c] / kPi + mix_d[c] * dv;
+    const double metal = mix_m[c] * dv;
     const double f = (1.0 - metallic) * dielectric + metallic * metal;
-    const double f0_c = f0_d[c] * (1.0 - metallic) + base[c] * metallic;
-    const double ambient = kSky * ((1.0 - max_f0_d) * base[c] * (1.0 - metallic) + f0_c);
+    // The ambient light: the normal-incidence albedo, with the film's term at n . v.
+    const double f0_c = (f0_d[c] * (1.0 - k) + ir_d[c] * k) * (1.0 - metallic) +
+                        (base[c] * (1.0 - k) + ir_m[c] * k) * metallic;
+    const double diffuse_weight = 1.0 - (max_f0_d * (1.0 - k) + max_ir_d * k);
+    const double ambient = kSky * (diffuse_weight * base[c] * (1.0 - metallic) + f0_c);
     out[c] = ambient + kSun * std::max(0.0, n_l) * f + m.emissive_linear[c];
   }
   if (m.sheen_color_factor != glm::vec3(0.0f)) {
@@ -233,7 +298,7 @@ int worst_difference(
 
 }  // namespace
 
-TEST_CASE("ior specular clearcoat and sheen on a lit sphere match their formulas at every pixel",
+TEST_CASE("ior specular clearcoat sheen and iridescence on a lit sphere match their formulas",
           "[shading][analytic][extensions]") {
   struct Case {
     const char* name;
@@ -292,6 +357,17 @@ TEST_CASE("ior specular clearcoat and sheen on a lit sphere match their formulas
     m.clearcoat = 0.6f;
     m.clearcoat_roughness = 0.25f;
     m.emissive_linear = glm::vec3(0.0f, 0.03f, 0.0f);
+  });
+  add("iridescence over a dielectric", [](Material& m) {
+    m.iridescence = 1.0f;
+    m.iridescence_thickness_max_nm = 380.0f;
+  });
+  add("iridescence 0.6 over a metal, film ior 1.8", [](Material& m) {
+    m.metallic = 1.0f;
+    m.roughness = 0.4f;
+    m.iridescence = 0.6f;
+    m.iridescence_ior = 1.8f;
+    m.iridescence_thickness_max_nm = 250.0f;
   });
   const glm::dvec3 base(0.6, 0.3, 0.2);
   for (const Case& c : cases) {
@@ -441,7 +517,8 @@ TEST_CASE("glTF material extensions at their neutral values draw today's bytes",
       {"KHR_materials_ior", {{"ior", 1.5}}},
       {"KHR_materials_specular", {{"specularFactor", 1.0}, {"specularColorFactor", {1, 1, 1}}}},
       {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}, {"clearcoatRoughnessFactor", 0.4}}},
-      {"KHR_materials_sheen", {{"sheenColorFactor", {0, 0, 0}}, {"sheenRoughnessFactor", 0.5}}}};
+      {"KHR_materials_sheen", {{"sheenColorFactor", {0, 0, 0}}, {"sheenRoughnessFactor", 0.5}}},
+      {"KHR_materials_iridescence", {{"iridescenceFactor", 0.0}, {"iridescenceIor", 1.6}}}};
   std::ofstream(dir / "neutral.glb", std::ios::binary) << sphere_gltf(neutral);
   nlohmann::json coated = neutral;
   coated["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.0;
@@ -473,7 +550,14 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
                                {{"sheenColorFactor", {0.5, 0.25, 1.0}},
                                 {"sheenRoughnessFactor", 0.75},
                                 {"sheenColorTexture", {{"index", 0}}},
-                                {"sheenRoughnessTexture", {{"index", 0}}}}}};
+                                {"sheenRoughnessTexture", {{"index", 0}}}}},
+                              {"KHR_materials_iridescence",
+                               {{"iridescenceFactor", 0.5},
+                                {"iridescenceIor", 1.75},
+                                {"iridescenceThicknessMinimum", 150.0},
+                                {"iridescenceThicknessMaximum", 650.0},
+                                {"iridescenceTexture", {{"index", 0}}},
+                                {"iridescenceThicknessTexture", {{"index", 0}}}}}};
   std::ofstream(dir / "all.glb", std::ios::binary) << sphere_gltf(all);
   const covrast::Scene scene = covrast::load_mesh_scene(dir / "all.glb", 32, 32);
   for (const std::string& warning : scene.warnings)
@@ -497,6 +581,12 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
   REQUIRE(m.sheen_color_texture.texture);
   CHECK(m.sheen_color_texture.texture->srgb);  // sheenColorTexture is sRGB
   REQUIRE(m.sheen_roughness_texture.texture);
+  CHECK(m.iridescence == 0.5f);
+  CHECK(m.iridescence_ior == 1.75f);
+  CHECK(m.iridescence_thickness_min_nm == 150.0f);
+  CHECK(m.iridescence_thickness_max_nm == 650.0f);
+  REQUIRE(m.iridescence_texture.texture);
+  REQUIRE(m.iridescence_thickness_texture.texture);
   // The textured coat draws: the coat texture's R (200/255) scales clearcoatFactor, so it
   // differs from the same file without the coat texture.
   nlohmann::json untextured = all;
@@ -530,6 +620,12 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
        path + "KHR_materials_sheen.sheenColorFactor: expected an array of 3 numbers in 0..1"},
       {{{"KHR_materials_sheen", {{"sheenRoughnessFactor", "rough"}}}},
        path + "KHR_materials_sheen.sheenRoughnessFactor: expected a number in 0..1"},
+      {{{"KHR_materials_iridescence", {{"iridescenceIor", 0.5}}}},
+       path + "KHR_materials_iridescence.iridescenceIor: expected a number in 1.."},
+      {{{"KHR_materials_iridescence", {{"iridescenceThicknessMaximum", -1}}}},
+       path + "KHR_materials_iridescence.iridescenceThicknessMaximum: expected a number in 0.."},
+      {{{"KHR_materials_iridescence", {{"iridescenceFactor", {1}}}}},
+       path + "KHR_materials_iridescence.iridescenceFactor: expected a number in 0..1"},
       {{{"KHR_materials_ior", {{"ior", 0.5}}}},
        path + "KHR_materials_ior.ior: expected 0 or a number >= 1"},
       {{{"KHR_materials_ior", {{"ior", "1.5"}}}},
@@ -558,7 +654,8 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
       "lights": [{"type": "ambient"}],
       "meshes": [{"obj": "t.obj", "material": {"model": "pbr", "ior": 0, "specular_factor": 0.5,
                   "clearcoat": 1, "clearcoat_roughness": 0.25, "sheen_color": [1, 0.5, 0],
-                  "sheen_roughness": 0.5}}]})";
+                  "sheen_roughness": 0.5, "iridescence": 0.25, "iridescence_ior": 1.5,
+                  "iridescence_thickness_nm": 500}}]})";
   const covrast::Scene scene = covrast::load_scene(dir / "s.json");
   const Material& m = scene.meshes.at(0).materials.at(0);
   CHECK(m.ior == 0.0f);
@@ -568,6 +665,9 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
   CHECK(m.sheen_color_factor.r == 1.0f);  // sRGB, as every colour of a scene file
   CHECK(m.sheen_color_factor.g == Approx(0.214).epsilon(0.01));
   CHECK(m.sheen_roughness == 0.5f);
+  CHECK(m.iridescence == 0.25f);
+  CHECK(m.iridescence_ior == 1.5f);
+  CHECK(m.iridescence_thickness_max_nm == 500.0f);
 }
 
 TEST_CASE("the sheen under the studio environment against quadrature over its texels",

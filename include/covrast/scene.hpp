@@ -124,6 +124,15 @@ struct Material {
   float sheen_roughness = 0.0f;
   TextureSlot sheen_color_texture;  ///< sRGB texels
   TextureSlot sheen_roughness_texture;
+  /// KHR_materials_iridescence: a thin film over the material whose interference colours its
+  /// Fresnel term (Belcour and Barla 2017): strength (0..1; x the texture's R), the film's ior
+  /// (>= 1) and thickness [nm] (the maximum, or mix(minimum, maximum, the texture's G)).
+  float iridescence = 0.0f;
+  float iridescence_ior = 1.3f;
+  float iridescence_thickness_min_nm = 100.0f;
+  float iridescence_thickness_max_nm = 400.0f;
+  TextureSlot iridescence_texture;
+  TextureSlot iridescence_thickness_texture;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
@@ -134,11 +143,21 @@ struct Material {
   std::string base_color_texture_path;
 
   /// Every texture slot, in one order (for checks and listings that treat them alike).
-  std::array<const TextureSlot*, 12> texture_slots() const {
-    return {&base_color_texture,       &metallic_roughness_texture, &normal_texture,
-            &occlusion_texture,        &emissive_texture,           &specular_texture,
-            &specular_color_texture,   &clearcoat_texture,          &clearcoat_roughness_texture,
-            &clearcoat_normal_texture, &sheen_color_texture,        &sheen_roughness_texture};
+  std::array<const TextureSlot*, 14> texture_slots() const {
+    return {&base_color_texture,
+            &metallic_roughness_texture,
+            &normal_texture,
+            &occlusion_texture,
+            &emissive_texture,
+            &specular_texture,
+            &specular_color_texture,
+            &clearcoat_texture,
+            &clearcoat_roughness_texture,
+            &clearcoat_normal_texture,
+            &sheen_color_texture,
+            &sheen_roughness_texture,
+            &iridescence_texture,
+            &iridescence_thickness_texture};
   }
 };
 

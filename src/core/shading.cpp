@@ -5,6 +5,7 @@
 // ssaa and reference).
 #include "core/shading.hpp"
 #include "core/environment_lighting.hpp"
+#include "core/iridescence.hpp"
 #include "core/pbr_terms.hpp"
 #include "core/shading_inputs.hpp"
 #include "core/sheen.hpp"
@@ -87,6 +88,14 @@ glm::dvec3 environment_pbr(const SurfaceShading& s, const PbrPoint& m, const glm
           : m.c_diff * ((glm::dvec3(1.0) - m.f0_diffuse) * (e.irradiance * (1.0 / kPi)) -
                         (m.f90 - m.f0_diffuse) * e.irradiance_schlick);
   glm::dvec3 sum = s.occlusion * (diffuse + m.f0 * e.specular + gap * e.specular_schlick);
+  if (m.iridescence > 0.0) {
+    // F = mix(F, Ir, iridescence) with Ir constant over the lobe: Ir A, and the diffuse
+    // weighted by 1 - Ir_d.
+    const glm::dvec3 film =
+        m.c_diff * (glm::dvec3(1.0) - m.iridescent_diffuse) * (e.irradiance * (1.0 / kPi)) +
+        m.iridescent * e.specular;
+    sum = sum * (1.0 - m.iridescence) + s.occlusion * film * m.iridescence;
+  }
   // The suns as the directional lights they are, occluded like the rest of the environment
   // (as the viewers, which do not take suns out, occlude them).
   for (const EnvironmentSun& sun : environment->suns()) {
@@ -121,6 +130,11 @@ glm::dvec3 pbr_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::d
                         const glm::dvec3& n, const glm::dvec3& v) {
   glm::dvec3 sum =
       s.context->ambient * s.occlusion * ((glm::dvec3(1.0) - m.f0_diffuse) * m.c_diff + m.f0);
+  if (m.iridescence > 0.0) {
+    const glm::dvec3 film = s.context->ambient * s.occlusion *
+                            ((glm::dvec3(1.0) - m.iridescent_diffuse) * m.c_diff + m.iridescent);
+    sum = sum * (1.0 - m.iridescence) + film * m.iridescence;
+  }
   for (const PunctualLight& light : s.context->lights) {
     const Incident in = incident(light, p);
     const double n_dot_l = glm::dot(n, in.l);
@@ -192,8 +206,9 @@ glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, const glm:
 /// coated (KHR_materials_clearcoat, "fresnel_coat"):
 ///   L = L_base (1 - clearcoat Fc) + clearcoat Fc L_coat,  Fc = 0.04 + 0.96 (1 - |n_c . v|)^5,
 /// L_base with the emission (the coat darkens it too).
-glm::dvec3 pbr_shade(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
-                     const glm::dvec3& n, const glm::dvec3& v) {
+glm::dvec3 pbr_shade(const SurfaceShading& s, PbrPoint m, const glm::dvec3& p, const glm::dvec3& n,
+                     const glm::dvec3& v) {
+  if (s.iridescence > 0.0 && n != glm::dvec3(0.0)) m.set_iridescence(s, glm::dot(n, v));
   glm::dvec3 base;
   if (m.sheen_color == glm::dvec3(0.0) || n == glm::dvec3(0.0)) {
     base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
@@ -225,9 +240,23 @@ glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
   const double alpha = std::max(m.roughness * m.roughness, kMinBrdfAlpha);
   const GgxLobe lobe = ggx_lobe(n, v, l, alpha * alpha);
   const double weight = schlick_weight(std::abs(lobe.h_dot_v));
-  const glm::dvec3 fresnel = m.f0 + (m.f90 - m.f0) * weight;
-  const glm::dvec3 fresnel_diffuse =
+  glm::dvec3 fresnel = m.f0 + (m.f90 - m.f0) * weight;
+  glm::dvec3 fresnel_diffuse =
       m.f0_diffuse == m.f0 ? fresnel : m.f0_diffuse + (m.f90 - m.f0_diffuse) * weight;
+  if (m.iridescence > 0.0) {
+    // KHR_materials_iridescence: over the dielectric and over the metal, F = mix(F, Ir, k)
+    // with the film's term Ir at n . v; the diffuse keeps what the dielectric's largest
+    // channel leaves (the extension's rgb_mix).
+    const double k = m.iridescence;
+    const glm::dvec3 dielectric =
+        (m.dielectric_f0 + (glm::dvec3(m.dielectric_f90) - m.dielectric_f0) * weight) * (1.0 - k) +
+        m.iridescent_dielectric * k;
+    const glm::dvec3 metal =
+        (m.base + (glm::dvec3(1.0) - m.base) * weight) * (1.0 - k) + m.iridescent_metal * k;
+    fresnel = dielectric * (1.0 - m.metallic) + metal * m.metallic;
+    const double strongest = std::max({dielectric.r, dielectric.g, dielectric.b});
+    fresnel_diffuse = glm::dvec3(strongest) * (1.0 - m.metallic) + metal * m.metallic;
+  }
   return (glm::dvec3(1.0) - fresnel_diffuse) * m.c_diff * (1.0 / kPi) + fresnel * lobe.d_vis;
 }
 
@@ -254,6 +283,8 @@ PbrPoint::PbrPoint(const SurfaceShading& s, const glm::dvec3& base_color,
   // specular 1) this is the core material's F0 = lerp(0.04, base, metallic), F90 = 1, bit for bit.
   const glm::dvec3 dielectric_f0 =
       glm::min(s.ior_f0 * s.specular_color, glm::dvec3(1.0)) * s.specular_weight;
+  this->dielectric_f0 = dielectric_f0;
+  dielectric_f90 = s.specular_weight;
   c_diff = base * (1.0 - metallic);
   f0 = dielectric_f0 * (1.0 - metallic) + base * metallic;
   f90 = glm::dvec3(s.specular_weight + (1.0 - s.specular_weight) * metallic);
@@ -261,6 +292,23 @@ PbrPoint::PbrPoint(const SurfaceShading& s, const glm::dvec3& base_color,
   f0_diffuse = dielectric_f0 == glm::dvec3(strongest)
                    ? f0
                    : glm::dvec3(strongest) * (1.0 - metallic) + base * metallic;
+}
+
+void PbrPoint::set_iridescence(const SurfaceShading& s, double n_dot_v) {
+  // KHR_materials_iridescence: the film over the dielectric (its F0 with the specular
+  // extension's colour and weight) and over the metal (F0 = base), seen at n . v, mixed by
+  // metallic as F0 is; the diffuse keeps what the dielectric film's largest channel leaves.
+  iridescence = s.iridescence;
+  const double cos_theta1 = std::min(std::abs(n_dot_v), 1.0);
+  const glm::dvec3 over_dielectric = iridescent_fresnel(1.0, s.iridescence_ior, dielectric_f0,
+                                                        s.iridescence_thickness_nm, cos_theta1);
+  const glm::dvec3 over_metal =
+      iridescent_fresnel(1.0, s.iridescence_ior, base, s.iridescence_thickness_nm, cos_theta1);
+  iridescent_dielectric = over_dielectric;
+  iridescent_metal = over_metal;
+  iridescent = over_dielectric * (1.0 - metallic) + over_metal * metallic;
+  const double strongest = std::max({over_dielectric.r, over_dielectric.g, over_dielectric.b});
+  iridescent_diffuse = glm::dvec3(strongest) * (1.0 - metallic) + over_metal * metallic;
 }
 
 glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
@@ -344,6 +392,8 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   s.clearcoat_roughness = sample.clearcoat_roughness;
   s.sheen_color = sample.sheen_color;
   s.sheen_roughness = sample.sheen_roughness;
+  s.iridescence = sample.iridescence;
+  s.iridescence_thickness_nm = sample.iridescence_thickness_nm;
   return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
                             sample.clearcoat_normal));
 }

@@ -63,8 +63,10 @@ struct SurfaceTextures {
   const TextureSlot* clearcoat = nullptr;            ///< KHR_materials_clearcoat, R
   const TextureSlot* clearcoat_roughness = nullptr;  ///< KHR_materials_clearcoat, G
   const TextureSlot* clearcoat_normal = nullptr;
-  const TextureSlot* sheen_color = nullptr;      ///< KHR_materials_sheen, RGB
-  const TextureSlot* sheen_roughness = nullptr;  ///< KHR_materials_sheen, A
+  const TextureSlot* sheen_color = nullptr;            ///< KHR_materials_sheen, RGB
+  const TextureSlot* sheen_roughness = nullptr;        ///< KHR_materials_sheen, A
+  const TextureSlot* iridescence = nullptr;            ///< KHR_materials_iridescence, R
+  const TextureSlot* iridescence_thickness = nullptr;  ///< KHR_materials_iridescence, G
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -90,6 +92,12 @@ struct SurfaceShading {
   /// pbr, KHR_materials_sheen: the sheen's colour (0: none) and perceptual roughness.
   glm::dvec3 sheen_color{0.0};
   double sheen_roughness = 0.0;
+  /// pbr, KHR_materials_iridescence: strength (0: none), the film's ior and thickness (the
+  /// maximum; the thickness texture lerps from the minimum to it).
+  double iridescence = 0.0;
+  double iridescence_ior = 1.3;
+  double iridescence_thickness_nm = 400.0;
+  double iridescence_thickness_min_nm = 100.0;
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
@@ -135,6 +143,8 @@ struct SurfaceSample {
   glm::dvec3 clearcoat_normal{0.0};
   glm::dvec3 sheen_color{0.0};   ///< the surface's, times the sheen colour texture
   double sheen_roughness = 0.0;  ///< the surface's, times the sheen roughness texture's A
+  double iridescence = 0.0;      ///< the surface's, times the iridescence texture's R
+  double iridescence_thickness_nm = 400.0;  ///< the maximum, or lerped by the texture's G
 };
 
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
@@ -180,6 +190,17 @@ struct PbrPoint {
   glm::dvec3 coat_normal;
   glm::dvec3 sheen_color;
   double sheen_roughness;
+  /// The dielectric's F0 and F90 before metallic (the thin film's base, and its mix).
+  glm::dvec3 dielectric_f0;
+  double dielectric_f90;
+  /// KHR_materials_iridescence (set by set_iridescence): its strength, the film's Fresnel term
+  /// at n . v over the dielectric and over the metal, their mix by metallic, and the same with
+  /// the dielectric's reduced to its largest channel (the diffuse weight under the environment
+  /// and the ambient light).
+  double iridescence = 0.0;
+  glm::dvec3 iridescent_dielectric{0.0}, iridescent_metal{0.0};
+  glm::dvec3 iridescent{0.0}, iridescent_diffuse{0.0};
+  void set_iridescence(const SurfaceShading& s, double n_dot_v);
 };
 
 /// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-

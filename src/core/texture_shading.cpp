@@ -80,12 +80,13 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
 }
 
 /// The textures of KHR_materials_specular (strength in A, F0 colour in RGB),
+/// KHR_materials_iridescence (strength in R, thickness in G: mix(minimum, maximum, G)),
 /// KHR_materials_sheen (colour in RGB, roughness in A) and KHR_materials_clearcoat (weight in R,
 /// roughness in G, its own normal map, which perturbs the interpolated normal, not the base's
 /// mapped one); each multiplies the surface's factor.
-void sample_material_extensions(const SurfaceTextures& slots, const TexturedCorners& corners,
-                                const double mu[3], const WeightDerivatives& d,
-                                SurfaceSample& out) {
+void sample_material_extensions(const SurfaceShading& s, const SurfaceTextures& slots,
+                                const TexturedCorners& corners, const double mu[3],
+                                const WeightDerivatives& d, SurfaceSample& out) {
   if (slots.specular != nullptr) out.specular_weight *= lookup(*slots.specular, corners, mu, d).a;
   if (slots.specular_color != nullptr) {
     out.specular_color *= glm::dvec3(lookup(*slots.specular_color, corners, mu, d));
@@ -93,6 +94,13 @@ void sample_material_extensions(const SurfaceTextures& slots, const TexturedCorn
   if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d).r;
   if (slots.clearcoat_roughness != nullptr) {
     out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d).g;
+  }
+  if (slots.iridescence != nullptr) out.iridescence *= lookup(*slots.iridescence, corners, mu, d).r;
+  if (slots.iridescence_thickness != nullptr) {
+    const double g = lookup(*slots.iridescence_thickness, corners, mu, d).g;
+    out.iridescence_thickness_nm =
+        s.iridescence_thickness_min_nm +
+        (s.iridescence_thickness_nm - s.iridescence_thickness_min_nm) * g;
   }
   if (slots.sheen_color != nullptr) {
     out.sheen_color *= glm::dvec3(lookup(*slots.sheen_color, corners, mu, d));
@@ -136,6 +144,8 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.clearcoat_normal = normal;
   out.sheen_color = s.sheen_color;
   out.sheen_roughness = s.sheen_roughness;
+  out.iridescence = s.iridescence;
+  out.iridescence_thickness_nm = s.iridescence_thickness_nm;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
   if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d);
@@ -155,7 +165,7 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
     out.normal = perturbed_normal(lookup(*slots.normal, corners, mu, d), slots.normal->scale,
                                   corners, mu, normal);
   }
-  sample_material_extensions(slots, corners, mu, d, out);
+  sample_material_extensions(s, slots, corners, mu, d, out);
   return out;
 }
 

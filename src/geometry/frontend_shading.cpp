@@ -57,6 +57,8 @@ SurfaceTextures surface_textures(const Material& m, bool lit) {
   out.clearcoat_normal = slot(m.clearcoat_normal_texture);
   out.sheen_color = slot(m.sheen_color_texture);
   out.sheen_roughness = slot(m.sheen_roughness_texture);
+  out.iridescence = slot(m.iridescence_texture);
+  out.iridescence_thickness = slot(m.iridescence_thickness_texture);
   return out;
 }
 
@@ -65,7 +67,8 @@ bool any_texture(const SurfaceTextures& t) {
          t.occlusion != nullptr || t.emissive != nullptr || t.specular != nullptr ||
          t.specular_color != nullptr || t.clearcoat != nullptr ||
          t.clearcoat_roughness != nullptr || t.clearcoat_normal != nullptr ||
-         t.sheen_color != nullptr || t.sheen_roughness != nullptr;
+         t.sheen_color != nullptr || t.sheen_roughness != nullptr || t.iridescence != nullptr ||
+         t.iridescence_thickness != nullptr;
 }
 
 }  // namespace
@@ -104,6 +107,10 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.clearcoat_roughness = m.clearcoat_roughness;
   s.sheen_color = glm::dvec3(m.sheen_color_factor);
   s.sheen_roughness = m.sheen_roughness;
+  s.iridescence = m.iridescence;
+  s.iridescence_ior = m.iridescence_ior;
+  s.iridescence_thickness_nm = m.iridescence_thickness_max_nm;
+  s.iridescence_thickness_min_nm = m.iridescence_thickness_min_nm;
   return s;
 }
 

@@ -160,6 +160,20 @@ Material convert_material(const tinygltf::Material& source) {
   return m;
 }
 
+/// KHR_materials_iridescence: iridescenceFactor (0..1) and its texture (R), iridescenceIor
+/// (>= 1), iridescenceThicknessMinimum and Maximum (nm, >= 0) and the thickness texture (G).
+void read_iridescence(const ExtensionObject& e, const std::string& name, GltfTextures& textures,
+                      Material& m) {
+  m.iridescence = static_cast<float>(number_in(e, "iridescenceFactor", 0.0, 0.0, 1.0, name));
+  m.iridescence_ior = static_cast<float>(number_in(e, "iridescenceIor", 1.3, 1.0, 1e6, name));
+  m.iridescence_thickness_min_nm =
+      static_cast<float>(number_in(e, "iridescenceThicknessMinimum", 100.0, 0.0, 1e6, name));
+  m.iridescence_thickness_max_nm =
+      static_cast<float>(number_in(e, "iridescenceThicknessMaximum", 400.0, 0.0, 1e6, name));
+  m.iridescence_texture = texture(e, "iridescenceTexture", false, textures);
+  m.iridescence_thickness_texture = texture(e, "iridescenceThicknessTexture", false, textures);
+}
+
 }  // namespace
 
 std::vector<Material> read_materials(const tinygltf::Model& model, GltfTextures& textures,
@@ -202,6 +216,10 @@ void read_material_extensions(const tinygltf::Material& source, int index, GltfT
   }
   if (const ExtensionObject e = find_extension(source, index, kSheenExtension, name); e.value) {
     read_sheen(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kIridescenceExtension, name);
+      e.value) {
+    read_iridescence(e, name, textures, m);
   }
 }
 

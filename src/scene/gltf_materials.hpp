@@ -2,7 +2,7 @@
 // the material extensions that change the pbr material (docs/shading.md, "Material
 // extensions"), read as their specifications in
 // KhronosGroup/glTF, extensions/2.0/Khronos/, define them: KHR_materials_ior, _specular,
-// _clearcoat and _sheen.
+// _clearcoat, _sheen and _iridescence.
 #pragma once
 
 #include <covrast/scene.hpp>
@@ -24,6 +24,7 @@ inline constexpr std::string_view kIorExtension = "KHR_materials_ior";
 inline constexpr std::string_view kSpecularExtension = "KHR_materials_specular";
 inline constexpr std::string_view kClearcoatExtension = "KHR_materials_clearcoat";
 inline constexpr std::string_view kSheenExtension = "KHR_materials_sheen";
+inline constexpr std::string_view kIridescenceExtension = "KHR_materials_iridescence";
 
 /// The file's materials as covrast shades them, in file order, then glTF's default material
 /// (for primitives without one): each material's factors (glTF 2.0, 3.9 and 5.19), textures

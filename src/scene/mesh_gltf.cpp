@@ -179,7 +179,7 @@ tinygltf::Model read_model(std::string_view bytes, const std::string& name,
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 14> kImplementedExtensions = {
+constexpr std::array<std::string_view, 15> kImplementedExtensions = {
     kDracoExtension,
     "EXT_mesh_gpu_instancing",
     "KHR_materials_emissive_strength",
@@ -193,7 +193,8 @@ constexpr std::array<std::string_view, 14> kImplementedExtensions = {
     kIorExtension,
     kSpecularExtension,
     kClearcoatExtension,
-    kSheenExtension};
+    kSheenExtension,
+    kIridescenceExtension};
 
 /// glTF 2.0, 3.12: a file that requires an extension the loader does not implement must not
 /// load, since drawing it without would be wrong.

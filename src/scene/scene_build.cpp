@@ -79,6 +79,15 @@ void check_material(const Material& m, const std::string& what) {
   if (!(m.sheen_roughness >= 0.0f && m.sheen_roughness <= 1.0f)) {
     fail(what, "sheen_roughness must be in 0..1");
   }
+  if (!(m.iridescence >= 0.0f && m.iridescence <= 1.0f)) fail(what, "iridescence must be in 0..1");
+  if (!(m.iridescence_ior >= 1.0f && std::isfinite(m.iridescence_ior))) {
+    fail(what, "iridescence_ior must be a finite number >= 1");
+  }
+  if (!(m.iridescence_thickness_min_nm >= 0.0f && m.iridescence_thickness_max_nm >= 0.0f &&
+        std::isfinite(m.iridescence_thickness_min_nm) &&
+        std::isfinite(m.iridescence_thickness_max_nm))) {
+    fail(what, "iridescence thicknesses must be finite and >= 0");
+  }
   if (!(m.clearcoat_roughness >= 0.0f && m.clearcoat_roughness <= 1.0f)) {
     fail(what, "clearcoat_roughness must be in 0..1");
   }

@@ -389,7 +389,7 @@ class SceneReader {
   }
 
   /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat,
-  /// _sheen).
+  /// _sheen, _iridescence).
   void apply_material_extensions(const json& object, const std::string& key, Material& m) const {
     if (const auto it = object.find("ior"); it != object.end()) {
       const double ior = number_in(*it, key + ".ior", 0.0, 1e6);
@@ -403,6 +403,16 @@ class SceneReader {
     }
     if (const auto it = object.find("clearcoat"); it != object.end()) {
       m.clearcoat = static_cast<float>(number_in(*it, key + ".clearcoat", 0.0, 1.0));
+    }
+    if (const auto it = object.find("iridescence"); it != object.end()) {
+      m.iridescence = static_cast<float>(number_in(*it, key + ".iridescence", 0.0, 1.0));
+    }
+    if (const auto it = object.find("iridescence_ior"); it != object.end()) {
+      m.iridescence_ior = static_cast<float>(number_in(*it, key + ".iridescence_ior", 1.0, 10.0));
+    }
+    if (const auto it = object.find("iridescence_thickness_nm"); it != object.end()) {
+      m.iridescence_thickness_max_nm =
+          static_cast<float>(number_in(*it, key + ".iridescence_thickness_nm", 0.0, 10000.0));
     }
     if (const auto it = object.find("sheen_color"); it != object.end()) {
       m.sheen_color_factor = srgb_color(*it, key + ".sheen_color");
