@@ -63,6 +63,8 @@ class EnvironmentLighting {
 
   /// E(n) = int L(l) max(0, n . l) dl for a unit world-space normal.
   glm::dvec3 irradiance(const glm::dvec3& n_world) const;
+  /// E(n) without the suns (integrals()' irradiance, alone).
+  glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
 
   /// All four integrals, without the suns, for unit world-space n and v (n . v may be <= 0: then
   /// only E counts) and perceptual roughness in [0, 1].
@@ -90,7 +92,6 @@ class EnvironmentLighting {
 
   glm::dvec3 to_map(const glm::dvec3& d) const;
   glm::dvec3 to_world(const glm::dvec3& d) const;
-  glm::dvec3 irradiance_without_suns(const glm::dvec3& n_world) const;
   /// E(n) of the map without suns for a unit normal in the map's frame, by the pyramid walk.
   glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;
   glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;

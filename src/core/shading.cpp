@@ -177,10 +177,10 @@ glm::dvec3 clearcoat_radiance(const SurfaceShading& s, const PbrPoint& m, const 
 /// the ambient light and the environment (without its suns, lit as the directional lights they
 /// are) each times the sheen's albedo E(n . v) and occlusion): the environment's cosine-
 /// weighted mean radiance E_env(n) / pi stands for the radiance the broad sheen lobe gathers,
-/// exact for a uniform environment (docs/shading.md gives the error against quadrature).
-glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::dvec3& p,
-                          const glm::dvec3& n, const glm::dvec3& v) {
-  const double albedo = sheen_albedo(glm::dot(n, v), m.sheen_roughness);
+/// exact for a uniform environment (docs/shading.md gives the error against quadrature);
+/// `albedo` is E(n . v), which the base's scaling uses too.
+glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, double albedo,
+                          const glm::dvec3& p, const glm::dvec3& n, const glm::dvec3& v) {
   glm::dvec3 sum = s.context->ambient * (s.occlusion * albedo);
   for (const PunctualLight& light : s.context->lights) {
     const Incident in = incident(light, p);
@@ -189,8 +189,7 @@ glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, const glm:
     sum += in.irradiance * (sheen_lobe(n, v, in.l, m.sheen_roughness) * n_dot_l);
   }
   if (const EnvironmentLighting* environment = s.context->environment) {
-    sum +=
-        environment->integrals(n, v, m.sheen_roughness).irradiance * (s.occlusion * albedo / kPi);
+    sum += environment->irradiance_without_suns(n) * (s.occlusion * albedo / kPi);
     for (const EnvironmentSun& sun : environment->suns()) {
       const double n_dot_l = glm::dot(n, sun.to_light);
       if (!(n_dot_l > 0.0)) continue;
@@ -214,9 +213,10 @@ glm::dvec3 pbr_shade(const SurfaceShading& s, PbrPoint m, const glm::dvec3& p, c
     base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
   } else {
     const double strongest = std::max({m.sheen_color.r, m.sheen_color.g, m.sheen_color.b});
-    const double scaling = 1.0 - strongest * sheen_albedo(glm::dot(n, v), m.sheen_roughness);
+    const double albedo = sheen_albedo(glm::dot(n, v), m.sheen_roughness);
+    const double scaling = 1.0 - strongest * albedo;
     base = (pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v)) * scaling +
-           sheen_radiance(s, m, p, n, v) + s.emissive;
+           sheen_radiance(s, m, albedo, p, n, v) + s.emissive;
   }
   if (!(m.clearcoat > 0.0)) return base;
   const double coat = m.clearcoat * clearcoat_fresnel(m.coat_normal, v);
