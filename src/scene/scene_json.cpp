@@ -3,6 +3,7 @@
 // linear light, and loads each mesh file once however many instances name it.
 #include "scene/gltf_animation.hpp"
 #include "scene/scene_internal.hpp"
+#include "scene/scene_keys.hpp"
 
 #include <glm/gtc/matrix_transform.hpp>
 #include <nlohmann/json.hpp>
@@ -1041,6 +1042,7 @@ Scene scene_from_root(const json& root, const std::string& file,
   const SceneReader reader(file);
 
   Scene scene;
+  scene.warnings = detail::unknown_scene_keys(root, file);
   scene.width = reader.image_side(root, "width");
   scene.height = reader.image_side(root, "height");
   if (const auto it = root.find("background"); it != root.end()) {
