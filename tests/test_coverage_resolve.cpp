@@ -597,6 +597,9 @@ TEST_CASE("coverage mode: a sphere's front faces alone match the reference", "[c
 // All 25 touch the pixel. Expected (linear): red 0.25, blue 0.35, black 0.4. Overflow must neither
 // drop the farther triangle nor lose the merged slivers' sample masks.
 TEST_CASE("coverage mode: more fragments than a pixel list holds keep their places", "[coverage]") {
+  // The list's overflow policy: the pixels' logs would take these fragments first.
+  const covrast::test::ScopedHook list_only(covrast::detail::testing::coverage_hooks.list_only,
+                                            true);
   for (bool back_first : {false, true}) {
     Scene s = make_scene(40, 40, glm::vec3(0));
     std::vector<ScreenVertex> fan;
@@ -674,6 +677,9 @@ int samples_inside(const std::vector<ScreenVertex>& v, int x_px, int y_px) {
 // missing area is mostly pieces of the front surface too thin to own a sample.)
 TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of its winners",
           "[coverage]") {
+  // The list's overflow policy: the pixels' logs would take these fragments first.
+  const covrast::test::ScopedHook list_only(covrast::detail::testing::coverage_hooks.list_only,
+                                            true);
   // On the 1/256 grid, so that snapping keeps it exactly.
   const std::vector<ScreenVertex> a = {
       {20.44140625, 20.875, 0.9}, {20.00390625, 20.1875, 0.9}, {20.69140625, 21.0, 0.9}};
@@ -715,6 +721,9 @@ TEST_CASE("coverage mode: a pixel turned into samples keeps the exact areas of i
 // fragment depth-tested with S's plane alone, R's quadrant would show red.
 TEST_CASE("coverage mode: a merged fragment's pieces are depth-tested with their own planes",
           "[coverage]") {
+  // The list's overflow policy: the pixels' logs would take these fragments first.
+  const covrast::test::ScopedHook list_only(covrast::detail::testing::coverage_hooks.list_only,
+                                            true);
   const FragmentCapacity capacity(3);
   Scene s = make_scene(40, 40, glm::vec3(0));
   const glm::vec3 red(1, 0, 0), blue(0, 0, 1);
@@ -979,13 +988,20 @@ TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sampl
     add_triangle_pair(s, a, red, b, sky, one_mesh);
     const std::vector<TriangleSetup> tris = screen_triangles(s);
     REQUIRE(tris.size() == 2);
-    const auto result = render(s, ModeKind::Coverage);
-    const Comparison c = compare(result.color, reference_render(s, tris));
-    WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes") << ": " << describe(c));
-    // Where the crossing line meets a triangle's edge, the samples decide.
-    CHECK(result.stats.resolve_paths.samples > 0);
-    CHECK(c.max_diff_linear <= kMaskToleranceLinear);
-    CHECK(c.mean_diff8 < 0.1);
+    // Where the crossing line meets a triangle's edge, the samples decide: the log's sample
+    // masks (planes compared per sample where depth ranges overlap), or the list's samples.
+    for (bool list_only : {false, true}) {
+      const covrast::test::ScopedHook hook(covrast::detail::testing::coverage_hooks.list_only,
+                                           list_only);
+      const auto result = render(s, ModeKind::Coverage);
+      const Comparison c = compare(result.color, reference_render(s, tris));
+      WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes")
+                                << (list_only ? ", list" : ", log") << ": " << describe(c));
+      const covrast::CoverageResolvePaths& paths = result.stats.resolve_paths;
+      CHECK((list_only ? paths.samples : paths.masked) > 0);
+      CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+      CHECK(c.mean_diff8 < 0.1);
+    }
   }
 }
 
@@ -1170,6 +1186,9 @@ TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from th
                                        glm::dvec4(0, 0, p[3], 0), glm::dvec4(p[0], p[1], p[2], 1));
   }
   covrast::detail::testing::CoverageHooks& hooks = covrast::detail::testing::coverage_hooks;
+  // The list's sums (the pixels' logs would take these pixels first: their proven layers
+  // resolve from the same sums, test_pixel_log.cpp).
+  const covrast::test::ScopedHook list_only(hooks.list_only, true);
   for (int tile : {16, 64}) {
     INFO("tile " << tile);
     const auto sums = render(s, ModeKind::Coverage, 2, tile);
@@ -1204,11 +1223,14 @@ TEST_CASE("coverage resolve: every pixel takes exactly one counted path", "[cove
     CHECK(a.front_layer == b.front_layer);
     CHECK(a.samples == b.samples);
     CHECK(a.clipped == b.clipped);
+    CHECK(a.proven_layer == b.proven_layer);
+    CHECK(a.masked == b.masked);
     CHECK(a.opaque + a.uniform_block + a.uniform_tile ==
           b.opaque + b.uniform_block + b.uniform_tile);
-    // The scene has a sphere over the background, slivers and an interpenetrating pair.
-    CHECK(a.layer_sums > 0);
-    CHECK(a.samples + a.front_layer > 0);
+    // The scene has a sphere over the background, slivers and an interpenetrating pair:
+    // proven layers inside the sphere, masks at its silhouette and where the pair crosses.
+    CHECK(a.proven_layer > 0);
+    CHECK(a.masked > 0);
   }
   // The other modes count nothing.
   CHECK(render(s, ModeKind::Aliased).stats.resolve_paths.total() == 0);

@@ -21,6 +21,8 @@ struct CoverageResolvePaths {
   std::uint64_t samples = 0;        ///< list: 256-sample visibility, exact-area weights
   std::uint64_t overflowed = 0;     ///< the list overflowed into 256 depth-tested samples
   std::uint64_t transparent = 0;    ///< BLEND fragments composited in depth order
+  std::uint64_t proven_layer = 0;   ///< log: fragments proven to tile the pixel, from their areas
+  std::uint64_t masked = 0;         ///< log: sample masks front to back, exact-area weights
 
   std::uint64_t total() const;
   CoverageResolvePaths& operator+=(const CoverageResolvePaths& o);
@@ -38,7 +40,9 @@ inline constexpr std::pair<const char*, std::uint64_t CoverageResolvePaths::*>
                                     {"clipped", &CoverageResolvePaths::clipped},
                                     {"samples", &CoverageResolvePaths::samples},
                                     {"overflowed", &CoverageResolvePaths::overflowed},
-                                    {"transparent", &CoverageResolvePaths::transparent}};
+                                    {"transparent", &CoverageResolvePaths::transparent},
+                                    {"proven_layer", &CoverageResolvePaths::proven_layer},
+                                    {"masked", &CoverageResolvePaths::masked}};
 static_assert(sizeof(CoverageResolvePaths) == sizeof(kCoverageResolvePathFields) /
                                                   sizeof(kCoverageResolvePathFields[0]) *
                                                   sizeof(std::uint64_t),

@@ -45,6 +45,10 @@ struct CoverageHooks {
   /// match within rounding. Pixels with transparent fragments then take the per-sample
   /// composite, never the uniform-layer shortcut (docs/transparency.md).
   std::atomic<bool> mask_resolve{false};
+  /// Read once per tile: no pixel logs its fragments (raster/coverage/pixel_log.hpp); each
+  /// goes to the A-buffer's fragment list at once, as it did before the log (the list's
+  /// paths then run on any scene; the log's resolve differs from it within the tests' bounds).
+  std::atomic<bool> list_only{false};
   /// Read when an A-buffer is made: it keeps at most this many fragments per pixel (clamped
   /// to 2..kMaxFragmentsPerPixel; 0 = kMaxFragmentsPerPixel), so that small scenes reach the
   /// overflow policy.

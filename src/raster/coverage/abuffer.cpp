@@ -73,7 +73,9 @@ ABufferTile::ABufferTile(int tile_px)
     : stride_(tile_px),
       capacity_(fragment_capacity()),
       mixed_capacity_(std::min(capacity_, kMaxMixedFragments)),
-      block_stride_((tile_px + kBlockPx - 1) / kBlockPx) {
+      block_stride_((tile_px + kBlockPx - 1) / kBlockPx),
+      log_(std::size_t(tile_px) * tile_px),
+      log_on_(true) {
   const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);
   block_uniform_.resize(blocks);
   block_opaque_.resize(blocks);
@@ -101,6 +103,8 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   std::fill(decided_.begin(), decided_.end(), 0);
   decided_stamp_ = 0;
   pool_.clear();
+  log_.clear_entries();
+  log_on_ = !testing::coverage_hooks.list_only.load(std::memory_order_relaxed);
   merged_slot_.clear();
   merged_.clear();
   samples_.clear();
@@ -141,6 +145,7 @@ void ABufferTile::materialize_block(std::size_t b) {
       open_count_[pixel] = 0;
       closed_count_[pixel] = 0;
       occluder_z_[pixel] = kFar;
+      log_.start_pixel(pixel, log_on_);
     }
   }
 }
@@ -201,6 +206,6 @@ std::size_t ABufferTile::scratch_bytes() const {
          pool_.capacity() * sizeof(Fragment) + merged_slot_.capacity() * sizeof(std::uint32_t) +
          merged_.capacity() * sizeof(MergedPiece) + samples_.capacity() * sizeof(PixelSamples) +
          transparent_head_.size() * sizeof(std::uint32_t) +
-         transparent_pool_.capacity() * sizeof(Fragment);
+         transparent_pool_.capacity() * sizeof(Fragment) + log_.scratch_bytes();
 }
 }  // namespace covrast::detail

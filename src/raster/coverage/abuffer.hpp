@@ -5,6 +5,14 @@
 // samples), abuffer_resolve.cpp and abuffer_visibility.cpp (the resolve), abuffer_planes.hpp
 // (depth planes and pixel polygons they share).
 //
+// Partly covered pixels first log their fragments without any overlap test (pixel_log.hpp):
+// most pixels of a dense mesh are tiled by one layer of its triangles, which the log proves
+// from the edges its fragments share and resolves from their areas; a pixel where layers
+// meet resolves from its fragments' sample masks, front to back (abuffer_logged.cpp). The
+// machinery below serves the rest: pixels whose first partial fragment meets a fragment list
+// already there, logs that grow past kMaxLoggedFragments, transparent pixels, and the
+// testing switches that ask for it.
+//
 // Fully covered pixels take a fast path: an ordinary depth test against one opaque
 // surface per pixel (depth planes compared at the pixel's four corners, so a plane that
 // crosses the opaque one inside the pixel is kept as a fragment instead). The same test
@@ -39,6 +47,7 @@
 #include "core/tile_raster.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/pixel_log.hpp"
 #include "raster/coverage/sample_mask.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
 
@@ -196,6 +205,24 @@ class ABufferTile {
 
   inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
                                          std::size_t pixel, int x, int y) const;
+  /// add() for a pixel whose log is not Off: logs the fragment, drops it (hidden), or returns
+  /// false for the list to take it (after turning the log Off and handing its fragments on).
+  inline bool log_fragment(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                           std::uint32_t coverage, double centre_z);
+  /// add() for a pixel whose log is Off: the list.
+  inline void add_to_list(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                          std::uint32_t coverage, double centre_z);
+  /// Turns the pixel's log Off and adds its fragments to the list, in arrival order: the
+  /// state the list would have had from the start (abuffer_logged.cpp).
+  void hand_log_to_list(std::size_t pixel, int x, int y);
+  /// Resolves a pixel with a non-empty log into color_ and depth_ (abuffer_logged.cpp).
+  void resolve_logged(std::size_t pixel, int x, int y, glm::vec3 background);
+  /// A proven layer: its areas add, as a disjoint open set's sums do.
+  void resolve_proven(std::size_t pixel, int x, int y);
+  /// Any other log: each fragment's 256-sample mask, nearest first; the samples a nearer
+  /// fragment holds are hidden (per sample by the planes where depth ranges overlap), and a
+  /// fragment weighs its exact area times the share of its samples it keeps.
+  void resolve_masked(std::size_t pixel, int x, int y, glm::vec3 background);
   static constexpr int kBlockPx = kAbufferBlockPx;
   std::size_t block_of(int x, int y) const {
     return std::size_t((y - rect_.y0) / kBlockPx) * block_stride_ + (x - rect_.x0) / kBlockPx;
@@ -343,6 +370,9 @@ class ABufferTile {
   /// Per pixel, a depth at or behind which nothing is visible: the farthest depth of the
   /// closed sets so far, or (a margin behind) of a sampled pixel's samples (+inf: none).
   std::vector<double> occluder_z_;
+  /// The pixels' logs (pixel_log.hpp); on unless testing::CoverageHooks::list_only.
+  PixelLog log_;
+  bool log_on_;
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
   std::vector<MergedPiece> merged_;
@@ -399,6 +429,41 @@ inline void ABufferTile::prepare_row(int x0, int x1, int y) {
 inline void ABufferTile::add(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                              double centre_z) {
   const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+  if (log_.state(pixel) != LogState::Off && log_fragment(pixel, x, y, *t, coverage, centre_z)) {
+    return;
+  }
+  add_to_list(pixel, x, y, t, coverage, centre_z);
+}
+
+inline bool ABufferTile::log_fragment(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                                      std::uint32_t coverage, double centre_z) {
+  const double reach = depth_reach(t);
+  if (log_.count(pixel) == 0) {
+    // Nothing logged: a full fragment is the ordinary depth test against the opaque one.
+    if (coverage == std::uint32_t(kCoverageOne)) return false;
+    if (head_[pixel] != kEnd || layer_[pixel] != Layer::Empty) {
+      // That test kept a full fragment that crosses the opaque one: the list has begun.
+      log_.turn_off(pixel);
+      return false;
+    }
+  } else if (centre_z - reach >= log_.hidden_from(pixel)) {
+    return true;  // behind a proven layer all over the pixel
+  } else if (log_.count(pixel) == kMaxLoggedFragments) {
+    hand_log_to_list(pixel, x, y);
+    return false;
+  }
+  // The opaque surface (the nearest full fragment before the log began) stays apart, as the
+  // list keeps it: the resolve puts it behind the log.
+  if (opaque_[pixel] != nullptr &&
+      order_against_opaque(t, centre_z, pixel, x, y) == DepthOrder::Behind) {
+    return true;
+  }
+  log_.append(pixel, x, y, t, coverage, centre_z, reach);
+  return true;
+}
+
+inline void ABufferTile::add_to_list(std::size_t pixel, int x, int y, const TriangleSetup* t,
+                                     std::uint32_t coverage, double centre_z) {
   if (centre_z - depth_reach(*t) >= occluder_z_[pixel]) return;  // behind a closed set or samples
   // Hidden by the closed set: behind (or level with, being later) every member it overlaps.
   if (closed_count_[pixel] != 0 && behind_closed_set(pixel, *t, [&](const TriangleSetup& m) {

@@ -154,4 +154,30 @@ struct SamplePlane {
   }
 };
 
+/// Whether fragment i is the nearest at point p of its part of the pixel among the fragments
+/// that cover p (nearer, or level and earlier, than each). Samples cannot tell it for a
+/// fragment too thin to own one: two such slivers folded over one another along a shared
+/// edge own the same (no) samples and each would show.
+template <class Merged>
+bool nearest_at_point(int n, const TriangleSetup* const* tri, const Merged* const* merged, int i,
+                      double px, double py) {
+  const double z = tri[i]->depth_at(px, py);
+  auto hides = [&](const TriangleSetup& o) {
+    if (!covers_point(o, px, py)) return false;
+    const double oz = o.depth_at(px, py);
+    return oz < z || (oz == z && o.primitive < tri[i]->primitive);
+  };
+  for (int j = 0; j < n; ++j) {
+    if (j == i) continue;
+    if (merged[j] == nullptr) {
+      if (hides(*tri[j])) return false;
+      continue;
+    }
+    for (int k = 0; k < merged[j]->pieces; ++k) {
+      if (hides(*merged[j]->piece[k])) return false;
+    }
+  }
+  return true;
+}
+
 }  // namespace covrast::detail

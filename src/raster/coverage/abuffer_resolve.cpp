@@ -374,6 +374,15 @@ void ABufferTile::resolve_tile(const FrameTarget& target) {
       for (int y = br.y0; y < br.y1; ++y) {
         for (int x = br.x0; x < br.x1; ++x) {
           const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+          if (log_.count(pixel) != 0) {
+            // Transparent fragments and the list-resolve switches: the list takes the log.
+            if (!use_sums || (any_transparent_ && transparent_head_[pixel] != kEnd)) {
+              hand_log_to_list(pixel, x, y);
+            } else {
+              resolve_logged(pixel, x, y, target.background_linear);
+              continue;
+            }
+          }
           if (any_transparent_ && transparent_head_[pixel] != kEnd) {
             // Transparent fragments: none of the one-layer shortcuts (they assume nothing
             // in front of the opaque resolve).

@@ -1,0 +1,243 @@
+// Raster stage, coverage mode: the resolve of pixels that logged their fragments
+// (pixel_log.hpp), and the hand-over of a log to the fragment list.
+#include "core/checks.hpp"
+#include "core/shading.hpp"
+#include "raster/coverage/abuffer.hpp"
+#include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/sample_mask.hpp"
+#include "raster/coverage/triangle_overlap.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace covrast::detail {
+namespace {
+
+/// nearest_at_point's view of merged fragments, of which a log has none.
+struct NotMerged {
+  int pieces;
+  const TriangleSetup* piece[1];
+};
+
+bool any(const SampleMask& m) { return (m.word[0] | m.word[1] | m.word[2] | m.word[3]) != 0; }
+
+/// A masked pixel's fragments (the log's, and the opaque surface as one that covers the
+/// pixel), nearest first once sorted, and what the masked resolve finds for each.
+struct MaskedPixel {
+  static constexpr int kCapacity = kMaxLoggedFragments + 1;
+  int n = 0;
+  const TriangleSetup* tri[kCapacity];
+  std::uint32_t coverage[kCapacity];
+  double centre_z[kCapacity];
+  double near[kCapacity], far[kCapacity];  ///< where the plane lies within the pixel
+  SampleMask mask[kCapacity], kept[kCapacity];
+  SampleMask held = SampleMask::none();  ///< the samples some fragment holds
+  bool lost_any = false;                 ///< a fragment lost samples to a nearer one
+  int shown = 0;             ///< fragments from here on lie behind full coverage (no mask)
+  int considered = 0;        ///< fragments with a weight: the shown ones and the nearest hidden one
+  double weight[kCapacity];  ///< [pixels]
+  bool estimated[kCapacity];
+
+  void add(const TriangleSetup& t, std::uint32_t c, double z, double reach) {
+    tri[n] = &t;
+    coverage[n] = c;
+    centre_z[n] = z;
+    near[n] = z - reach;
+    far[n] = z + reach;
+    ++n;
+  }
+  double area(int i) const { return double(coverage[i]) / kCoverageOne; }
+
+  /// By the near end of the range, ties in arrival order (insertion sort: stable, and short).
+  void sort_nearest_first() {
+    for (int i = 1; i < n; ++i) {
+      const TriangleSetup* t = tri[i];
+      const std::uint32_t c = coverage[i];
+      const double z = centre_z[i], lo = near[i], hi = far[i];
+      int j = i;
+      for (; j > 0 && near[j - 1] > lo; --j) {
+        tri[j] = tri[j - 1];
+        coverage[j] = coverage[j - 1];
+        centre_z[j] = centre_z[j - 1];
+        near[j] = near[j - 1];
+        far[j] = far[j - 1];
+      }
+      tri[j] = t, coverage[j] = c, centre_z[j] = z, near[j] = lo, far[j] = hi;
+    }
+  }
+
+  /// Front to back: fragment i takes the samples of its mask that no nearer fragment holds.
+  /// Behind a holder's whole range it loses the shared samples at once; where the ranges
+  /// overlap, the planes decide each shared sample (nearer wins; level: the earlier
+  /// primitive), as the list's samples do. Once every sample is held and the next range
+  /// starts behind every range so far, the rest is hidden: their masks are never computed.
+  void take_samples(int x, int y) {
+    double farthest = -std::numeric_limits<double>::infinity();
+    shown = n;
+    for (int i = 0; i < n; ++i) {
+      if (near[i] > farthest && held == SampleMask::all()) {
+        shown = i;
+        lost_any = true;
+        return;
+      }
+      farthest = std::max(farthest, far[i]);
+      mask[i] = pixel_sample_mask(*tri[i], x, y);
+      SampleMask free = mask[i];
+      for (int j = 0; j < i; ++j) {
+        const SampleMask shared = free & kept[j];
+        if (!any(shared)) continue;
+        lost_any = true;
+        if (far[j] <= near[i]) {
+          for (int w = 0; w < 4; ++w) free.word[w] &= ~shared.word[w];
+        } else {
+          split_shared(x, y, i, j, shared, free);
+        }
+      }
+      kept[i] = free;
+      held |= mask[i];
+    }
+  }
+
+  /// The samples `shared` by fragments i and j whose ranges overlap, sample by sample.
+  void split_shared(int x, int y, int i, int j, const SampleMask& shared, SampleMask& free) {
+    const SamplePlane plane_i(*tri[i], x, y), plane_j(*tri[j], x, y);
+    const bool i_first = tri[i]->primitive < tri[j]->primitive;
+    for_each_sample(shared, [&](int k) {
+      const double zi = plane_i.at(k), zj = plane_j.at(k);
+      const std::uint64_t bit = 1ull << (k & 63);
+      if (zi < zj || (zi == zj && i_first)) {
+        kept[j].word[k >> 6] &= ~bit;
+      } else {
+        free.word[k >> 6] &= ~bit;
+      }
+    });
+  }
+
+  /// The weights, as the list's sample resolve gives them: the exact area where a fragment
+  /// keeps all its samples; else its area times the share it keeps, those estimates scaled
+  /// together to fill what the exact areas and the background's samples leave, each at most
+  /// its area. A sliver that owns no sample shows or not at a point inside its part of the
+  /// pixel, against every fragment that covers the point (as the list does).
+  void weigh(int x, int y) {
+    const NotMerged* const no_merged[kCapacity] = {};  // a log holds no merges
+    double exact = 0.0, estimate = 0.0;
+    for (int i = 0; i < shown; ++i) {
+      const int own = mask[i].count(), keeps = kept[i].count();
+      estimated[i] = own != 0 && keeps != own;
+      if (own == 0) {
+        double px, py;
+        const bool shows = inner_point(part_in_pixel(*tri[i], x, y), px, py) &&
+                           nearest_at_point(n, tri, no_merged, i, px, py);
+        weight[i] = shows ? area(i) : 0.0;
+      } else {
+        weight[i] = keeps == own ? area(i) : area(i) * double(keeps) / own;
+      }
+      (estimated[i] ? estimate : exact) += weight[i];
+    }
+    // The nearest of the hidden fragments: what shows through the strips between samples
+    // that the exact areas leave, as the list's opaque surface does.
+    considered = shown < n ? shown + 1 : n;
+    if (shown < n) {
+      weight[shown] = 0.0;
+      estimated[shown] = true;
+    }
+    if (!lost_any) return;
+    // What the exact areas and the background leave goes to the estimates, in proportion;
+    // when none kept a sample, to the nearest hidden fragment.
+    const double behind_share = double(kMaskSamples - held.count()) / kMaskSamples;
+    const bool to_hidden = !(estimate > 0.0) && shown < n;
+    const double basis = to_hidden ? area(shown) : estimate;
+    const double scale = basis > 0.0 ? std::max(0.0, 1.0 - exact - behind_share) / basis : 0.0;
+    for (int i = 0; i < considered; ++i) {
+      if (!estimated[i] || (to_hidden && i != shown)) continue;
+      weight[i] = std::min((to_hidden ? area(i) : weight[i]) * scale, area(i));
+    }
+  }
+};
+
+}  // namespace
+
+void ABufferTile::hand_log_to_list(std::size_t pixel, int x, int y) {
+  // The fragments leave the log before the list takes them (add_to_list never logs).
+  LoggedFragment logged[kMaxLoggedFragments];
+  int n = 0;
+  log_.for_each(pixel, [&](const LoggedFragment& f) { logged[n++] = f; });
+  log_.turn_off(pixel);
+  for (int i = 0; i < n; ++i) {
+    add_to_list(pixel, x, y, logged[i].triangle, logged[i].coverage, logged[i].centre_z);
+  }
+}
+
+void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 background) {
+  // A proven layer hides the opaque surface when it lies in front of it all over the pixel.
+  const TriangleSetup* opaque = opaque_[pixel];
+  if (log_.state(pixel) == LogState::Proven &&
+      (opaque == nullptr || log_.hidden_from(pixel) < opaque_z_[pixel] - depth_reach(*opaque))) {
+    ++paths_.proven_layer;
+    resolve_proven(pixel, x, y);
+    return;
+  }
+  ++paths_.masked;
+  resolve_masked(pixel, x, y, background);
+}
+
+void ABufferTile::resolve_proven(std::size_t pixel, int x, int y) {
+  COVRAST_CHECK(
+      [&] {
+        const TriangleSetup* tri[kMaxLoggedFragments];
+        int n = 0;
+        log_.for_each(pixel, [&](const LoggedFragment& f) { tri[n++] = f.triangle; });
+        for (int i = 0; i < n; ++i) {
+          for (int j = i + 1; j < n; ++j) {
+            if (!interiors_disjoint(*tri[i], *tri[j])) return false;
+          }
+        }
+        return true;
+      }(),
+      "a proven layer's fragments are pairwise disjoint");
+  // As the open set's running sums (add_to_sums), in arrival order: the same bits.
+  LayerSums sums{0, {0.0, 0.0, 0.0}, std::numeric_limits<float>::infinity(), 0.0, kNoConvexKey};
+  log_.for_each(pixel, [&](const LoggedFragment& f) {
+    const glm::vec3 c = shade(*f.triangle, x + 0.5, y + 0.5, true);
+    sums.coverage += f.coverage;
+    sums.rgb[0] += double(f.coverage) * c.r;
+    sums.rgb[1] += double(f.coverage) * c.g;
+    sums.rgb[2] += double(f.coverage) * c.b;
+    sums.depth = std::min(sums.depth, float(f.centre_z));
+  });
+  COVRAST_CHECK(sums.coverage >= std::uint32_t(kCoverageOne), "a proven layer fills its pixel");
+  color_[pixel] = front_layer_color(sums, glm::vec3(0.0f));  // nothing of what is behind shows
+  depth_[pixel] = sums.depth;
+}
+
+void ABufferTile::resolve_masked(std::size_t pixel, int x, int y, glm::vec3 background) {
+  MaskedPixel p;
+  if (opaque_[pixel] != nullptr) {
+    // The opaque surface takes part as a fragment that covers the pixel.
+    p.add(*opaque_[pixel], std::uint32_t(kCoverageOne), opaque_z_[pixel],
+          depth_reach(*opaque_[pixel]));
+  }
+  log_.for_each(
+      pixel, [&](const LoggedFragment& f) { p.add(*f.triangle, f.coverage, f.centre_z, f.reach); });
+  p.sort_nearest_first();
+  p.take_samples(x, y);
+  p.weigh(x, y);
+  double total = 0.0;
+  for (int i = 0; i < p.considered; ++i) total += p.weight[i];
+  const double scale = total > 1.0 ? 1.0 / total : 1.0;
+  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
+  glm::dvec3 rgb(0.0);
+  float depth = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < p.considered; ++i) {
+    COVRAST_CHECK(p.weight[i] >= 0.0 && p.weight[i] <= p.area(i) * (1.0 + 1e-9),
+                  "a fragment's visible weight lies between 0 and its exact area");
+    depth = std::min(depth, float(p.centre_z[i]));
+    if (p.weight[i] == 0.0) continue;
+    rgb += p.weight[i] * scale * glm::dvec3(shade(*p.tri[i], x + 0.5, y + 0.5, true));
+  }
+  color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(background));
+  depth_[pixel] = depth;
+}
+
+}  // namespace covrast::detail
