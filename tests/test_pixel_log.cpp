@@ -154,14 +154,20 @@ TEST_CASE("pixel log: a tiling proves a layer, which hides what lies behind it",
 
 TEST_CASE("pixel log: proven layers give the list's bytes, and every path is taken",
           "[coverage][log]") {
-  // A closed sphere, back faces culled, small enough that its triangles are near pixel size:
-  // its interior pixels are tiled by one layer of them.
+  // Two spheres whose triangles are near pixel size. The left one is analysed: convex, its
+  // back faces culled, its pieces of one facing taken as disjoint. The right one is not: its
+  // back faces are drawn behind its front, and only the edge keys prove its front layer; at
+  // its silhouette the two layers meet, and the masks decide.
   covrast::Scene s = covrast::test::pixel_scene(128, 96);
   s.camera.eye = glm::dvec3(0.0, 0.3, 3.2);
-  s.camera.fovy_deg = 30.0;
-  auto sphere = covrast::test::uv_sphere(40, 80);
-  covrast::analyze_mesh_topology(*sphere);
-  covrast::test::add_instance(s, sphere, glm::vec3(1), covrast::ColorSource::PerTriangle);
+  s.camera.fovy_deg = 40.0;
+  auto convex = covrast::test::uv_sphere(40, 80);
+  covrast::analyze_mesh_topology(*convex);
+  covrast::test::add_instance(s, convex, glm::vec3(1), covrast::ColorSource::PerTriangle);
+  s.meshes.back().model[3] = glm::dvec4(-0.55, 0.0, 0.0, 1.0);
+  covrast::test::add_instance(s, covrast::test::uv_sphere(40, 80), glm::vec3(1),
+                              covrast::ColorSource::PerTriangle);
+  s.meshes.back().model[3] = glm::dvec4(0.55, 0.0, -0.3, 1.0);
   const covrast::RenderResult log = render_coverage(s, false);
   const covrast::RenderResult list = render_coverage(s, true);
   const covrast::CoverageResolvePaths& paths = log.stats.resolve_paths;

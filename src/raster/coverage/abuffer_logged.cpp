@@ -175,14 +175,29 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
   if (log_.state(pixel) == LogState::Proven &&
       (opaque == nullptr || log_.hidden_from(pixel) < opaque_z_[pixel] - depth_reach(*opaque))) {
     ++paths_.proven_layer;
-    resolve_proven(pixel, x, y);
+    resolve_proven(pixel);
+    return;
+  }
+  // Pieces of one facing of a convex surface that do not fill the pixel (its silhouette), in
+  // front of the opaque surface all over the pixel or with none behind: their areas add over
+  // what is behind, as the list's open set adds them.
+  if (log_.state(pixel) == LogState::Open && log_.one_convex_facing(pixel) &&
+      (opaque == nullptr || log_.farthest(pixel) < opaque_z_[pixel] - depth_reach(*opaque))) {
+    ++paths_.proven_layer;
+    const PixelLog::LayerColor& c = log_.layer_color(pixel);
+    const LayerSums sums{
+        log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
+    const glm::vec3 behind =
+        opaque != nullptr ? shade(*opaque, x + 0.5, y + 0.5, true) : background;
+    color_[pixel] = front_layer_color(sums, behind);
+    depth_[pixel] = opaque != nullptr ? std::min(c.depth, float(opaque_z_[pixel])) : c.depth;
     return;
   }
   ++paths_.masked;
   resolve_masked(pixel, x, y, background);
 }
 
-void ABufferTile::resolve_proven(std::size_t pixel, int x, int y) {
+void ABufferTile::resolve_proven(std::size_t pixel) {
   COVRAST_CHECK(
       [&] {
         const TriangleSetup* tri[kMaxLoggedFragments];
@@ -190,22 +205,19 @@ void ABufferTile::resolve_proven(std::size_t pixel, int x, int y) {
         log_.for_each(pixel, [&](const LoggedFragment& f) { tri[n++] = f.triangle; });
         for (int i = 0; i < n; ++i) {
           for (int j = i + 1; j < n; ++j) {
+            // Pairs of one convex facing are taken as disjoint without a test, as by the
+            // list (docs/coverage.md, section 3a: snapped slivers at a silhouette).
+            if (one_convex_facing(*tri[i], *tri[j])) continue;
             if (!interiors_disjoint(*tri[i], *tri[j])) return false;
           }
         }
         return true;
       }(),
       "a proven layer's fragments are pairwise disjoint");
-  // As the open set's running sums (add_to_sums), in arrival order: the same bits.
-  LayerSums sums{0, {0.0, 0.0, 0.0}, std::numeric_limits<float>::infinity(), 0.0, kNoConvexKey};
-  log_.for_each(pixel, [&](const LoggedFragment& f) {
-    const glm::vec3 c = shade(*f.triangle, x + 0.5, y + 0.5, true);
-    sums.coverage += f.coverage;
-    sums.rgb[0] += double(f.coverage) * c.r;
-    sums.rgb[1] += double(f.coverage) * c.g;
-    sums.rgb[2] += double(f.coverage) * c.b;
-    sums.depth = std::min(sums.depth, float(f.centre_z));
-  });
+  // The log's running sums, kept as the open set's are (add_to_sums): the same bits.
+  const PixelLog::LayerColor& c = log_.layer_color(pixel);
+  const LayerSums sums{
+      log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
   COVRAST_CHECK(sums.coverage >= std::uint32_t(kCoverageOne), "a proven layer fills its pixel");
   color_[pixel] = front_layer_color(sums, glm::vec3(0.0f));  // nothing of what is behind shows
   depth_[pixel] = sums.depth;

@@ -2,6 +2,7 @@
 #include "raster/coverage/pixel_log.hpp"
 
 #include "core/checks.hpp"
+#include "core/shading.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
 
 #include <algorithm>
@@ -71,12 +72,20 @@ std::uint64_t EdgeCrossingKeys::crossing_sum(int x, int y) const {
   return sum;
 }
 
+std::uint64_t PixelLog::crossing_key(const TriangleSetup& t, std::uint32_t coverage, int x, int y) {
+  if (coverage == std::uint32_t(kCoverageOne)) return 0;  // no edge in the pixel
+  if (keys_.triangle() != &t) keys_.set(t);
+  return keys_.crossing_sum(x, y);
+}
+
 PixelLog::PixelLog(std::size_t pixels)
     : state_(pixels, LogState::Off),
       count_(pixels),
       head_(pixels),
       tail_(pixels),
       coverage_sum_(pixels),
+      sums_(pixels),
+      convex_(pixels),
       key_sum_(pixels),
       far_(pixels),
       hidden_from_(pixels) {}
@@ -98,6 +107,8 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   if (n == 0) {
     head_[pixel] = index;
     coverage_sum_[pixel] = 0;
+    sums_[pixel] = LayerColor{{0.0, 0.0, 0.0}, INFINITY};
+    convex_[pixel] = convex_key(t);
     key_sum_[pixel] = 0;
     far_[pixel] = -INFINITY;
     hidden_from_[pixel] = INFINITY;
@@ -111,13 +122,32 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
     return;
   }
   coverage_sum_[pixel] += coverage;
-  if (coverage != std::uint32_t(kCoverageOne)) {  // a full fragment has no edge in the pixel
-    if (keys_.triangle() != &t) keys_.set(t);
-    key_sum_[pixel] += keys_.crossing_sum(x, y);
+  const bool was_convex = convex_[pixel] != kNotConvex;
+  if (convex_[pixel] != convex_key(t)) convex_[pixel] = kNotConvex;
+  // The running sums of a layer, as the list's open set keeps them (the same order and bits).
+  const glm::vec3 c = shade(t, x + 0.5, y + 0.5, true);
+  LayerColor& sums = sums_[pixel];
+  sums.rgb[0] += double(coverage) * c.r;
+  sums.rgb[1] += double(coverage) * c.g;
+  sums.rgb[2] += double(coverage) * c.b;
+  sums.depth = std::min(sums.depth, float(centre_z));
+  if (convex_[pixel] == kNotConvex) {
+    // The keys are needed from the first fragment that is not of the one convex facing on;
+    // then those of the fragments before it as well (their triangles are read again).
+    if (was_convex && n > 0) {
+      std::uint32_t e = head_[pixel];
+      for (int i = 0; i < n; ++i, e = entries_[e].next) {
+        key_sum_[pixel] += crossing_key(*entries_[e].triangle, entries_[e].coverage, x, y);
+      }
+    }
+    key_sum_[pixel] += crossing_key(t, coverage, x, y);
   }
   far_[pixel] = std::max(far_[pixel], centre_z + reach);
   if (coverage_sum_[pixel] < std::uint32_t(kCoverageOne)) return;
-  if (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2) {
+  // Pieces of one facing of a convex surface do not overlap (TriangleSetup::convex_surface):
+  // reaching the pixel, they cover it, as the list's open set closes.
+  if (convex_[pixel] != kNotConvex ||
+      (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2)) {
     state_[pixel] = LogState::Proven;
     hidden_from_[pixel] = far_[pixel];
   } else {
@@ -127,7 +157,8 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
 
 std::size_t PixelLog::scratch_bytes() const {
   return state_.size() * (sizeof(LogState) + sizeof(std::uint8_t) + 3 * sizeof(std::uint32_t) +
-                          sizeof(std::uint64_t) + 2 * sizeof(double)) +
+                          sizeof(std::uint64_t) + 2 * sizeof(double) + sizeof(LayerColor) +
+                          sizeof(std::uint32_t)) +
          entries_.capacity() * sizeof(LoggedFragment);
 }
 

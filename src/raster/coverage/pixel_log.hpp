@@ -96,6 +96,20 @@ class PixelLog {
   int count(std::size_t pixel) const { return count_[pixel]; }
   /// A depth at or behind which nothing shows (a proven layer's farthest; +inf: none).
   double hidden_from(std::size_t pixel) const { return hidden_from_[pixel]; }
+  /// A proven layer's colour sums: sum(coverage_i * linear colour_i) in arrival order, and
+  /// the nearest centre depth.
+  struct LayerColor {
+    double rgb[3];
+    float depth;
+  };
+  const LayerColor& layer_color(std::size_t pixel) const { return sums_[pixel]; }
+  /// While Open: whether every fragment is of one convex surface and facing
+  /// (TriangleSetup::convex_surface), whose pieces do not overlap: the list's open set takes
+  /// them as disjoint without a test (docs/coverage.md, section 3a, on snapped slivers).
+  bool one_convex_facing(std::size_t pixel) const { return convex_[pixel] != kNotConvex; }
+  /// While Open: the farthest depth a fragment reaches in the pixel.
+  double farthest(std::size_t pixel) const { return far_[pixel]; }
+  std::uint32_t coverage_sum(std::size_t pixel) const { return coverage_sum_[pixel]; }
   /// Appends a fragment (`reach`: how far its plane moves from centre_z within the pixel)
   /// and advances the pixel's state (the header's proof).
   void append(std::size_t pixel, int x, int y, const TriangleSetup& t, std::uint32_t coverage,
@@ -114,12 +128,21 @@ class PixelLog {
   std::size_t scratch_bytes() const;
 
  private:
+  /// The keys of the edges of `t` that cross pixel (x, y); none for a full fragment.
+  std::uint64_t crossing_key(const TriangleSetup& t, std::uint32_t coverage, int x, int y);
+
   std::vector<LogState> state_;
   std::vector<std::uint8_t> count_;
   std::vector<std::uint32_t> head_, tail_;
   std::vector<std::uint32_t> coverage_sum_;  ///< while Open
-  std::vector<std::uint64_t> key_sum_;       ///< while Open
-  std::vector<double> far_;                  ///< while Open: the farthest depth reached
+  std::vector<LayerColor> sums_;             ///< while Open
+  std::vector<std::uint32_t> convex_;        ///< while Open: convex_key of all, or kNotConvex
+  static constexpr std::uint32_t kNotConvex = 0xffffffffu;
+  static std::uint32_t convex_key(const TriangleSetup& t) {
+    return t.convex_surface ? t.surface * 2 + (t.front_facing ? 1u : 0u) : kNotConvex;
+  }
+  std::vector<std::uint64_t> key_sum_;  ///< while Open
+  std::vector<double> far_;             ///< while Open: the farthest depth reached
   std::vector<double> hidden_from_;
   std::vector<LoggedFragment> entries_;
   EdgeCrossingKeys keys_;
