@@ -218,7 +218,7 @@ class ABufferTile {
   /// Resolves a pixel with a non-empty log into color_ and depth_ (abuffer_logged.cpp).
   void resolve_logged(std::size_t pixel, int x, int y, glm::vec3 background);
   /// A proven layer: its areas add, as a disjoint open set's sums do.
-  void resolve_proven(std::size_t pixel);
+  void resolve_proven(std::size_t pixel, int x, int y);
   /// Any other log: each fragment's 256-sample mask, nearest first; the samples a nearer
   /// fragment holds are hidden (per sample by the planes where depth ranges overlap), and a
   /// fragment weighs its exact area times the share of its samples it keeps.
