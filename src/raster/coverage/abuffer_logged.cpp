@@ -8,7 +8,6 @@
 #include "raster/coverage/triangle_overlap.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <limits>
 
@@ -21,44 +20,13 @@ struct NotMerged {
   const TriangleSetup* piece[1];
 };
 
-/// The area [pixels^2] that triangles a and b share inside pixel (x, y): the pixel square
-/// clipped by the six edges (Sutherland-Hodgman in double). For the invariant checks: the log
-/// proves its layers disjoint inside the pixel, not as whole triangles.
+/// The area [pixels^2] that triangles a and b share inside pixel (x, y). For the invariant
+/// checks: the log proves its layers disjoint inside the pixel, not as whole triangles.
 [[maybe_unused]] double shared_area_in_pixel(const TriangleSetup& a, const TriangleSetup& b, int x,
                                              int y) {
-  std::array<double, 16> px{double(x), double(x + 1), double(x + 1), double(x)};
-  std::array<double, 16> py{double(y), double(y), double(y + 1), double(y + 1)};
-  int n = 4;
-  for (const TriangleSetup* t : {&a, &b}) {
-    const double s = 1.0 / kSubpixelOne;
-    const double twice = double(t->x_fx8[1] - t->x_fx8[0]) * (t->y_fx8[2] - t->y_fx8[0]) -
-                         double(t->x_fx8[2] - t->x_fx8[0]) * (t->y_fx8[1] - t->y_fx8[0]);
-    const double side = twice >= 0 ? 1.0 : -1.0;
-    for (int i = 0; i < 3 && n > 0; ++i) {
-      const int j = (i + 1) % 3;
-      const double xi = t->x_fx8[i] * s, yi = t->y_fx8[i] * s;
-      const double dx = t->x_fx8[j] * s - xi, dy = t->y_fx8[j] * s - yi;
-      auto f = [&](double qx, double qy) { return side * (dx * (qy - yi) - dy * (qx - xi)); };
-      std::array<double, 16> ox{}, oy{};
-      int m = 0;
-      for (int k = 0; k < n; ++k) {
-        const int l = (k + 1) % n;
-        const double fk = f(px[k], py[k]), fl = f(px[l], py[l]);
-        if (fk >= 0) ox[m] = px[k], oy[m++] = py[k];
-        if ((fk >= 0) != (fl >= 0)) {
-          const double u = fk / (fk - fl);
-          ox[m] = px[k] + u * (px[l] - px[k]), oy[m++] = py[k] + u * (py[l] - py[k]);
-        }
-      }
-      px = ox, py = oy, n = m;
-    }
-  }
-  double twice = 0.0;
-  for (int k = 0; k < n; ++k) {
-    const int l = (k + 1) % n;
-    twice += px[k] * py[l] - px[l] * py[k];
-  }
-  return 0.5 * std::fabs(twice);
+  ClipPolygon poly = part_in_pixel(a, x, y);
+  clip_by_triangle(poly, b);
+  return polygon_area(poly);
 }
 
 bool any(const SampleMask& m) { return (m.word[0] | m.word[1] | m.word[2] | m.word[3]) != 0; }
@@ -210,11 +178,20 @@ void ABufferTile::hand_log_to_list(std::size_t pixel, int x, int y) {
   }
 }
 
+ABufferTile::LayerSums ABufferTile::logged_sums(std::size_t pixel) const {
+  const PixelLog::LayerColor& c = log_.layer_color(pixel);
+  return LayerSums{
+      log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
+}
+
 void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 background) {
-  // A proven layer hides the opaque surface when it lies in front of it all over the pixel.
+  // A layer shows over the opaque surface alone when it lies in front of it all over the
+  // pixel: before the nearest the opaque plane comes (+inf: no opaque surface).
   const TriangleSetup* opaque = opaque_[pixel];
-  if (log_.state(pixel) == LogState::Proven &&
-      (opaque == nullptr || log_.hidden_from(pixel) < opaque_z_[pixel] - depth_reach(*opaque))) {
+  const double opaque_near = opaque != nullptr ? opaque_z_[pixel] - depth_reach(*opaque)
+                                               : std::numeric_limits<double>::infinity();
+  // A proven layer hides the opaque surface.
+  if (log_.state(pixel) == LogState::Proven && log_.hidden_from(pixel) < opaque_near) {
     ++paths_.proven_layer;
     resolve_proven(pixel, x, y);
     return;
@@ -223,15 +200,13 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
   // front of the opaque surface all over the pixel or with none behind: their areas add over
   // what is behind, as the list's open set adds them.
   if (log_.state(pixel) == LogState::Open && log_.one_convex_facing(pixel) &&
-      (opaque == nullptr || log_.farthest(pixel) < opaque_z_[pixel] - depth_reach(*opaque))) {
+      log_.farthest(pixel) < opaque_near) {
     ++paths_.proven_layer;
-    const PixelLog::LayerColor& c = log_.layer_color(pixel);
-    const LayerSums sums{
-        log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
+    const LayerSums sums = logged_sums(pixel);
     const glm::vec3 behind =
         opaque != nullptr ? shade(*opaque, x + 0.5, y + 0.5, true) : background;
     color_[pixel] = front_layer_color(sums, behind);
-    depth_[pixel] = opaque != nullptr ? std::min(c.depth, float(opaque_z_[pixel])) : c.depth;
+    depth_[pixel] = opaque != nullptr ? std::min(sums.depth, float(opaque_z_[pixel])) : sums.depth;
     return;
   }
   ++paths_.masked;
@@ -260,9 +235,7 @@ void ABufferTile::resolve_proven(std::size_t pixel, [[maybe_unused]] int x,
       }(),
       "a proven layer's fragments are pairwise disjoint inside the pixel");
   // The log's running sums, kept as the open set's are (add_to_sums): the same bits.
-  const PixelLog::LayerColor& c = log_.layer_color(pixel);
-  const LayerSums sums{
-      log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
+  const LayerSums sums = logged_sums(pixel);
   COVRAST_CHECK(sums.coverage >= std::uint32_t(kCoverageOne), "a proven layer fills its pixel");
   color_[pixel] = front_layer_color(sums, glm::vec3(0.0f));  // nothing of what is behind shows
   depth_[pixel] = sums.depth;

@@ -59,9 +59,10 @@ inline bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near,
   return level < 4 || near.primitive < far.primitive;
 }
 
-/// A convex polygon in pixel coordinates: the pixel square clipped by up to four lines.
+/// A convex polygon in pixel coordinates: the pixel square clipped by up to six lines (each
+/// line adds at most one vertex).
 struct ClipPolygon {
-  double x[8], y[8];
+  double x[10], y[10];
   int n = 0;
 };
 
@@ -94,6 +95,19 @@ inline double polygon_area(const ClipPolygon& poly) {
   return 0.5 * std::fabs(twice);
 }
 
+/// Keeps the part of `poly` inside triangle `t` (its three edges).
+inline void clip_by_triangle(ClipPolygon& poly, const TriangleSetup& t) {
+  // Inside edge i -> j (positive doubled area, y down): (xj - xi)(py - yi) - (yj - yi)(px - xi) >=
+  // 0.
+  const double s = 1.0 / kSubpixelOne;
+  for (int i = 0; i < 3 && poly.n > 0; ++i) {
+    const int j = (i + 1) % 3;
+    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
+    const double dx = t.x_fx8[j] * s - xi, dy = t.y_fx8[j] * s - yi;
+    clip_half_plane(poly, dy * xi - dx * yi, -dy, dx);
+  }
+}
+
 /// The part of pixel (x, y) inside triangle `t`: the pixel square clipped by its three edges.
 inline ClipPolygon part_in_pixel(const TriangleSetup& t, int x, int y) {
   ClipPolygon poly;
@@ -104,15 +118,7 @@ inline ClipPolygon part_in_pixel(const TriangleSetup& t, int x, int y) {
     poly.y[k] = py[k];
   }
   poly.n = 4;
-  // Inside edge i -> j (positive doubled area, y down): (xj - xi)(py - yi) - (yj - yi)(px - xi) >=
-  // 0.
-  const double s = 1.0 / kSubpixelOne;
-  for (int i = 0; i < 3 && poly.n > 0; ++i) {
-    const int j = (i + 1) % 3;
-    const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
-    const double dx = t.x_fx8[j] * s - xi, dy = t.y_fx8[j] * s - yi;
-    clip_half_plane(poly, dy * xi - dx * yi, -dy, dx);
-  }
+  clip_by_triangle(poly, t);
   return poly;
 }
 
