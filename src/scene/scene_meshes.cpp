@@ -118,7 +118,6 @@ void select_color(const SceneReader& reader, const std::string& file, const json
 
 }  // namespace
 
-/// The mesh that entry `key` names, drawn with material variant `variant` (empty: none).
 CachedMesh& SceneMeshes::get(const MeshFileRef& ref, const std::string& key, Scene& scene,
                              const std::string& variant) {
   const std::filesystem::path full = base_dir_ / std::filesystem::path(ref.relative);

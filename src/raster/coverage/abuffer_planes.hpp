@@ -97,8 +97,8 @@ inline double polygon_area(const ClipPolygon& poly) {
 
 /// Keeps the part of `poly` inside triangle `t` (its three edges).
 inline void clip_by_triangle(ClipPolygon& poly, const TriangleSetup& t) {
-  // Inside edge i -> j (positive doubled area, y down): (xj - xi)(py - yi) - (yj - yi)(px - xi) >=
-  // 0.
+  // Inside edge i -> j (positive doubled area, y down):
+  // (xj - xi)(py - yi) - (yj - yi)(px - xi) >= 0.
   const double s = 1.0 / kSubpixelOne;
   for (int i = 0; i < 3 && poly.n > 0; ++i) {
     const int j = (i + 1) % 3;
