@@ -1,7 +1,8 @@
-// Shading inputs of lit triangles, built by the geometry front end (src/geometry/frontend.cpp)
-// and read by shade() in every raster mode: the frame's lights (ShadingContext), a surface's
-// material (SurfaceShading, one per instance and material) and each set-up triangle's
-// world-space vertices and normals (ShadingRecord). Unlit triangles have none of these.
+// Shading inputs of lit triangles, built by the geometry front end
+// (src/geometry/frontend_shading.cpp) and read by shade() in every raster mode: the frame's
+// lights (ShadingContext), a surface's material (SurfaceShading, one per instance and
+// material) and each set-up triangle's world-space vertices and normals (ShadingRecord).
+// Unlit triangles have none of these.
 // The formulas are in docs/shading.md; all arithmetic is double, IEEE, no contraction.
 #pragma once
 

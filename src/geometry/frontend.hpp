@@ -5,8 +5,13 @@
 // order, faces in file order), so that the output order, and so the image, never depends
 // on the thread count.
 //
-// Hidden back faces of closed meshes are dropped here (see the comment at GeometryFrontEnd's
-// constructor in frontend.cpp for why that never changes the image).
+// Hidden back faces of closed meshes are dropped here (see the comment in frontend_cull.cpp
+// for why that never changes the image).
+//
+// One file per stage: frontend.cpp is the outline (the chunk loops and emit_triangle, which
+// runs the per-triangle stages); frontend_transform.cpp, frontend_clip.cpp, frontend_cull.cpp
+// (per instance; its per-triangle culls inline in frontend_cull.hpp), frontend_setup.hpp
+// (inline), frontend_shading.cpp; frontend_stages.hpp declares what they share.
 #pragma once
 
 #include "core/environment_lighting.hpp"
@@ -22,6 +27,9 @@
 #include <vector>
 
 namespace covrast::detail {
+
+struct ClippedPolygon;  // frontend_stages.hpp
+struct KeptTriangle;    // frontend_stages.hpp
 
 /// Triangles per setup/binning chunk: large enough to amortise a task, small enough to
 /// balance 500k triangles over a few cores.
@@ -199,6 +207,7 @@ class GeometryFrontEnd {
                    SetupCounters& counters) const;
 
  private:
+  /// The viewport transform and 24.8 snap of a clip position (frontend_stages.hpp).
   SnappedVertex snap(const glm::dvec4& clip) const;
   unsigned outcode(const glm::dvec4& clip) const;
   /// outcode(clip), bit for bit, for the planes_ the constructor sets.
@@ -243,11 +252,30 @@ class GeometryFrontEnd {
                      bool flat, std::uint32_t primitive, std::uint32_t surface, Sink& sink,
                      const ShadeVertex* shade = nullptr, const SurfaceShading* lit = nullptr,
                      const LazyShade* lazy = nullptr) const;
+  /// Clips a triangle with a vertex outside some plane and emits the fan of its polygon.
   /// `mvp`: view_projection_ times the instance's model matrix, as in transform_vertices.
+  void emit_clipped(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
+                    const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,
+                    Sink& sink, const ShadeVertex* shade = nullptr,
+                    const SurfaceShading* lit = nullptr) const;
+  /// The clip stage (frontend_clip.cpp): triangle `idx` of an instance clipped against the
+  /// planes in `out_any` (the union of its vertices' outcodes), with its colours and, when
+  /// `shade` is not null, its ShadeVertex, into `out` with its vertices snapped (out.count
+  /// below 3: nothing is left).
   void clip_triangle(std::size_t instance, const glm::dmat4& mvp, const std::uint32_t* idx,
-                     const glm::vec3* color, bool flat, unsigned out_any, std::uint32_t primitive,
-                     Sink& sink, const ShadeVertex* shade = nullptr,
-                     const SurfaceShading* lit = nullptr) const;
+                     const glm::vec3* color, unsigned out_any, const ShadeVertex* shade,
+                     ClippedPolygon& out) const;
+  /// The per-triangle culls (frontend_cull.hpp), each counted in sink.counters.culled: zero
+  /// area after snapping, wholly outside the image, a hidden back face (also counted in
+  /// backface_culled), a back face of a single-sided material. True when the triangle passes;
+  /// then `kept` holds its facing and touched pixels.
+  bool passes_culls(const SnappedVertex& v0, const SnappedVertex& v1, const SnappedVertex& v2,
+                    std::uint32_t primitive, Sink& sink, KeptTriangle& kept) const;
+  /// The shading set-up of a lit triangle (frontend_shading.cpp): its ShadingRecord (and
+  /// TexturedCorners) from its ShadeVertex (`shade`, or computed from `lazy`), in the order
+  /// set_up_triangle gave its vertices (`front`: v1 and v2 swapped), linked from `t`.
+  void set_up_shading(const ShadeVertex* shade, const SurfaceShading& lit, const LazyShade* lazy,
+                      bool front, Sink& sink, TriangleSetup& t) const;
   void setup_range(std::uint32_t chunk, Sink& sink) const;
   /// The triangles [g, end) of a lit instance (setup_range's loop with shading inputs).
   void setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end, Sink& sink) const;
@@ -275,7 +303,7 @@ class GeometryFrontEnd {
   /// then cover each point of the screen at most once, from any eye (clipping
   /// only cuts them smaller).
   bool convex_surface(std::size_t instance) const;
-  /// Conditions (a) and (b) (see frontend.cpp): the facing to drop if no vertex
+  /// Conditions (a) and (b) (see frontend_cull.cpp): the facing to drop if no vertex
   /// is clipped by the near or far plane, or 0.
   static unsigned cullable_facing(const MeshInstance& instance, const glm::dvec3& eye);
 

@@ -1,7 +1,7 @@
 // Geometry stage, shading set-up (frontend.hpp): the frame's lights and each instance's
-// materials in the form shade() evaluates them (core/shading_inputs.hpp), and the per-corner
-// shading inputs of each lit triangle the front end sets up: world positions and normals,
-// UVs and tangents, vertex alphas.
+// materials in the form shade() evaluates them (core/shading_inputs.hpp), the per-corner
+// shading inputs of each lit triangle the front end sets up (world positions and normals,
+// UVs and tangents, vertex alphas), and its ShadingRecord.
 #include "geometry/frontend.hpp"
 
 #include <cmath>
@@ -251,6 +251,46 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
   const glm::dvec3 face = glm::cross(e1, e2) * det_sign;
   const float w = glm::dot(glm::cross(face, tangent), bitangent) < 0.0 ? -1.0f : 1.0f;
   for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(glm::vec3(tangent), w);
+}
+
+void GeometryFrontEnd::set_up_shading(const ShadeVertex* shade, const SurfaceShading& lit,
+                                      const LazyShade* lazy, bool front, Sink& sink,
+                                      TriangleSetup& t) const {
+  // Computed only now, for triangles that survived every cull (half of a closed mesh's
+  // are hidden back faces).
+  ShadeVertex computed[3];
+  if (lazy != nullptr) {
+    shade_vertices(lazy->instance, lazy->local, *lazy->normal_matrix, *lazy->linear, lazy->det_sign,
+                   lit, computed);
+    shade = computed;
+  }
+  ShadingRecord& record = sink.shading->emplace_back();
+  // A back face (the file's counter-clockwise front turned away: clockwise on screen, or
+  // counter-clockwise under a mirroring model matrix) of a double-sided material is lit
+  // from the viewer's side: its normals flip (glTF 2.0, 3.9.5 doubleSided).
+  const float sign = lit.double_sided && front == sink.mirrored ? -1.0f : 1.0f;
+  const ShadeVertex* ordered[3] = {&shade[0], front ? &shade[2] : &shade[1],
+                                   front ? &shade[1] : &shade[2]};
+  for (int k = 0; k < 3; ++k) {
+    record.position_world[k] = ordered[k]->position_world;
+    record.normal_world[k] = sign * ordered[k]->normal_world;
+    record.vertex_alpha[k] = ordered[k]->alpha;
+  }
+  record.surface = &lit;
+  record.textured = nullptr;
+  if (lit.textures != nullptr) {
+    // The tangent turns with the normal (xyz and the bitangent sign): the whole frame of a
+    // back face is the front's mirrored, so its perturbed normal is the front's negated.
+    TexturedCorners& corners = sink.textured->emplace_back();
+    for (int k = 0; k < 3; ++k) {
+      for (int set = 0; set < kMaxTexcoordSets; ++set) corners.uv[set][k] = ordered[k]->uv[set];
+      corners.tangent_world[k] = sign * ordered[k]->tangent_world;
+    }
+    record.textured = &corners;
+  }
+  t.alpha_mode = lit.alpha_mode;
+  t.shading = &record;
+  t.flat_color = false;
 }
 
 void GeometryFrontEnd::vertex_alphas(std::size_t instance, std::size_t local,

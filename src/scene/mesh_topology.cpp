@@ -1,6 +1,6 @@
 // Load-time topology analysis for back-face culling: is a mesh a closed, consistently oriented
 // surface, and which way do its counter-clockwise faces point? (analyze_mesh_topology in
-// include/covrast/scene.hpp; the renderer's use of it is in src/geometry/frontend.cpp.)
+// include/covrast/scene.hpp; the renderer's use of it is in src/geometry/frontend_cull.cpp.)
 //
 // Steps, O(n log n) in the vertex and triangle counts, all by sorting:
 // 1. weld: referenced vertices sorted by the bits of their position, equal positions get one
