@@ -345,8 +345,10 @@ TEST_CASE("Transparency gives the same bytes for every thread count and tile siz
   }
 }
 
+// [sanitizer-slow]: a minute under ASan+UBSan; the reference mode's splits run there in the
+// supersampling tests, and its transparent composite in the other tests of this file.
 TEST_CASE("Transparency gives the same bytes for every thread count and tile size: reference",
-          "[transparency]") {
+          "[transparency][sanitizer-slow]") {
   require_same_bytes_over_threads_and_tiles(random_transparent_scene(), "reference");
 }
 

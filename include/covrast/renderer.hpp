@@ -33,6 +33,11 @@ struct RenderResult {
 class Renderer {
  public:
   /// Throws InputError for bad options (size, tile, mode parameters).
+  /// The Renderer keeps a reference to `scene`, not a copy: the scene must outlive it and stay
+  /// unchanged while it exists (meshes, instances, textures, environment). It does not
+  /// validate the scene (check_scene is O(triangles)): load_scene and load_mesh_scene give
+  /// valid scenes; for a scene built in code call check_scene first, since here an index out
+  /// of range or arrays whose sizes do not match are undefined behaviour.
   Renderer(const Scene& scene, const RenderOptions& options);
   ~Renderer();
   Renderer(const Renderer&) = delete;
@@ -45,7 +50,8 @@ class Renderer {
   std::unique_ptr<Impl> impl_;
 };
 
-/// One frame, convenience.
+/// One frame, convenience: Renderer(scene, options).render_frame(), with the same
+/// preconditions and exceptions.
 RenderResult render(const Scene& scene, const RenderOptions& options);
 
 /// Runs work(i) for every i in [0, count), several at once on up to `threads` worker threads
