@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <initializer_list>
 #include <memory>
@@ -410,7 +411,8 @@ TEST_CASE("environment: away from normal incidence the split sum's error stays a
 
 TEST_CASE("environment: scenes/studio.json gives the same bytes for every thread count and tile",
           "[environment][parallel]") {
-  const Scene scene = covrast::load_scene(std::string(COVRAST_SOURCE_DIR) + "/scenes/studio.json");
+  const Scene scene =
+      covrast::load_scene(std::filesystem::path(COVRAST_SOURCE_DIR) / "scenes" / "studio.json");
   covrast::RenderOptions options;
   options.width = 160;
   options.height = 90;
