@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "test_sphere_scene.hpp"
+#include "test_splits.hpp"
 
 using covrast::EnvironmentLight;
 using covrast::EnvironmentMap;
@@ -416,15 +417,9 @@ TEST_CASE("environment: scenes/studio.json gives the same bytes for every thread
   covrast::RenderOptions options;
   options.width = 160;
   options.height = 90;
-  options.threads = 1;
-  options.tile = 64;
-  const covrast::Image first = covrast::render(scene, options).color;
-  for (const auto& [threads, tile] : {std::pair{2, 16}, std::pair{3, 24}, std::pair{2, 128}}) {
-    INFO(threads << " threads, tile " << tile);
-    options.threads = threads;
-    options.tile = tile;
-    CHECK(covrast::render(scene, options).color.rgb == first.rgb);
-  }
+  const covrast::Image first =
+      covrast::test::expect_same_bytes_for_every_split(scene, options, {{2, 16}, {3, 24}, {2, 128}})
+          .color;
   // Lit by the environment: the gold sphere's middle is far from the background.
   CHECK(int(first.pixel(80, 45)[0]) > 120);
 }

@@ -11,6 +11,7 @@
 //   - a pixel blends with one 4-neighbour, by at most max(0.5, subpix).
 #include "post/fxaa.hpp"
 #include "test_meshes.hpp"
+#include "test_splits.hpp"
 
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -259,6 +260,7 @@ TEST_CASE("fxaa: the search presets are FXAA 3.11's", "[fxaa]") {
 namespace {
 
 using covrast::test::pixel_scene;
+using covrast::test::render_mode;
 
 void add_mesh(Scene& scene, std::vector<glm::vec3> positions, std::vector<std::uint32_t> indices,
               ColorSource source, std::vector<glm::vec3> colours = {}) {
@@ -293,30 +295,21 @@ Scene random_triangles_scene() {
   return scene;
 }
 
-RenderResult render_mode(const Scene& scene, const char* mode, int threads, int tile) {
-  RenderOptions options;
-  options.mode = parse_render_mode(mode);
-  options.threads = threads;
-  options.tile = tile;
-  return render(scene, options);
-}
-
 }  // namespace
 
 TEST_CASE("fxaa mode: the aliased frame through FXAA, the same bytes for every split",
           "[fxaa][pipeline][threads]") {
   const Scene scene = random_triangles_scene();
-  const Image aliased = render_mode(scene, "aliased", 1, 64).color;
+  const Image aliased = render_mode(scene, "aliased", 1, 64);
   const Image expected = detail::fxaa(aliased, FxaaOptions{});
   REQUIRE(expected.rgb != aliased.rgb);  // the scene has edges for FXAA to change
-  for (int threads : {1, 2, 3, 4}) {
-    for (int tile : {8, 16, 24, 64, 256}) {
-      const RenderResult r = render_mode(scene, "fxaa", threads, tile);
-      INFO("threads " << threads << ", tile " << tile);
-      CHECK(r.color.rgb == expected.rgb);
-      CHECK(r.stats.post_ms >= 0.0);
-    }
-  }
+  // Every split's bytes are the base's (1 thread, 64-pixel tiles), and the base's are FXAA's.
+  const RenderResult base = covrast::test::expect_same_bytes_for_every_split(
+      scene, "fxaa", covrast::test::every_split({1, 2, 3, 4}, {8, 16, 24, 64, 256}),
+      [](const RenderResult& r, const RenderResult&, covrast::test::Split) {
+        CHECK(r.stats.post_ms >= 0.0);
+      });
+  CHECK(base.color.rgb == expected.rgb);
 }
 
 TEST_CASE("fxaa mode: parsing, names and option checks", "[fxaa][pipeline]") {
@@ -352,8 +345,8 @@ TEST_CASE("fxaa mode: a tessellated surface stays flat inside", "[fxaa][pipeline
   }
   add_mesh(scene, std::move(positions), std::move(indices), ColorSource::Uniform);
   scene.meshes.back().color_linear = glm::vec3(0.8f, 0.5f, 0.2f);
-  const Image aliased = render_mode(scene, "aliased", 2, 16).color;
-  const Image fxaa = render_mode(scene, "fxaa", 2, 16).color;
+  const Image aliased = render_mode(scene, "aliased", 2, 16);
+  const Image fxaa = render_mode(scene, "fxaa", 2, 16);
   // Pixels whose centre lies 2 or more pixels inside the circle of the fan's inner radius
   // (55 cos(pi / 97)): their 3x3 blocks are all inside the surface.
   const Rgb surface = at(aliased, 80, 60);
@@ -388,7 +381,7 @@ TEST_CASE("fxaa mode: the seam scene stays one flat colour", "[fxaa][pipeline]")
   scene.camera.far = 10.0;
   covrast::test::add_instance(scene, covrast::test::uv_sphere(24, 48), scene.background_linear);
   for (const int tile : {16, 64}) {
-    const Image image = render_mode(scene, "fxaa", 2, tile).color;
+    const Image image = render_mode(scene, "fxaa", 2, tile);
     const Rgb background = at(image, 0, 0);
     int off = 0;
     for (int y = 0; y < image.height; ++y) {
@@ -399,6 +392,6 @@ TEST_CASE("fxaa mode: the seam scene stays one flat colour", "[fxaa][pipeline]")
   }
   // The check can fail: the same sphere in another colour is blended at its outline.
   scene.meshes[0].color_linear = glm::vec3(0.9f);
-  const Image lit = render_mode(scene, "fxaa", 2, 64).color;
-  CHECK(lit.rgb != render_mode(scene, "aliased", 2, 64).color.rgb);
+  const Image lit = render_mode(scene, "fxaa", 2, 64);
+  CHECK(lit.rgb != render_mode(scene, "aliased", 2, 64).rgb);
 }

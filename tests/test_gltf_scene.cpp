@@ -21,6 +21,7 @@
 
 #include "test_cli_run.hpp"
 #include "test_gltf_files.hpp"
+#include "test_meshes.hpp"
 #include "test_sphere_scene.hpp"
 #include "test_tempdir.hpp"
 
@@ -29,6 +30,7 @@ using Catch::Matchers::Contains;
 using covrast::Light;
 using covrast::LightType;
 using covrast::test::GltfBuilder;
+using covrast::test::render_mode;
 using nlohmann::json;
 
 namespace {
@@ -57,13 +59,6 @@ class TempDir : public covrast::test::TempDir {
     return {};
   }
 };
-
-covrast::Image render(const covrast::Scene& scene, const char* mode = "coverage") {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = 1;
-  return covrast::render(scene, options).color;
-}
 
 /// The square [-1, 1]^2 at z = 0 facing +z (node 0), as a 4-vertex strip.
 GltfBuilder square_file() {
@@ -155,8 +150,8 @@ TEST_CASE("KHR_lights_punctual lights join the scene with \"lights\": \"gltf\"",
   const covrast::Scene without_spot = dir.load(scene_json(json::array({entry}), explicit_lights));
   covrast::Scene from_file = scene;
   from_file.lights.pop_back();  // the spot, whose rotation is not exact in JSON numbers
-  const covrast::Image image = render(from_file);
-  CHECK(image.rgb == render(without_spot).rgb);
+  const covrast::Image image = render_mode(from_file, "coverage", 1);
+  CHECK(image.rgb == render_mode(without_spot, "coverage", 1).rgb);
   // Lit: the sun alone gives (1, 0.5, 0.25) x 2 + 0.1 at least: red saturates at the centre.
   CHECK(int(image.pixel(12, 12)[0]) == 255);
 
@@ -224,7 +219,7 @@ TEST_CASE("an orthographic camera covers exactly the predicted pixels", "[camera
   REQUIRE(scene.camera.ymag == 2.0);
   // x = -1 .. 1.4 is columns (x + 4) / 0.2 = 15 .. 27, y = 1 .. -0.6 rows (2 - y) / 0.2 = 5 .. 13.
   for (const char* mode : {"coverage", "aliased", "ssaa:4", "reference"}) {
-    const covrast::Image image = render(scene, mode);
+    const covrast::Image image = render_mode(scene, mode, 1);
     int wrong = 0;
     for (int y = 0; y < 20; ++y) {
       for (int x = 0; x < 40; ++x) {
@@ -251,7 +246,7 @@ TEST_CASE("orthographic shading sees every point from the same direction", "[cam
   // A plane, a directional light and parallel view rays: n, l and v are the same everywhere,
   // so every covered pixel has one colour (a perspective view varies the highlight).
   const auto colours = [&](const json& s) {
-    const covrast::Image image = render(dir.load(s), "aliased");
+    const covrast::Image image = render_mode(dir.load(s), "aliased", 1);
     std::vector<int> seen;
     for (int y = 0; y < 20; ++y) {
       for (int x = 0; x < 40; ++x) {
@@ -287,7 +282,7 @@ TEST_CASE("a glTF orthographic camera renders as the same scene camera", "[camer
   CHECK(from_file.camera.far == 10.0);
   const covrast::Scene written =
       dir.load({{"width", 40}, {"height", 20}, {"camera", ortho_camera()}, {"meshes", meshes}});
-  CHECK(render(from_file).rgb == render(written).rgb);
+  CHECK(render_mode(from_file, "coverage", 1).rgb == render_mode(written, "coverage", 1).rgb);
 
   b.gltf["cameras"][0]["orthographic"]["ymag"] = 0;
   dir.write("camera.glb", b.glb());
@@ -477,25 +472,27 @@ TEST_CASE("back faces of single-sided glTF materials are culled in every mode",
     for (const bool lit : {false, true}) {
       INFO(mode << (lit ? " lit" : " unlit"));
       // From the front both squares show; from behind single-sided ones vanish.
-      const auto front = covered_halves(render(scene("one.glb", 3, json::object(), lit), mode));
+      const auto front =
+          covered_halves(render_mode(scene("one.glb", 3, json::object(), lit), mode, 1));
       CHECK(front.first > 50);
       CHECK(front.second > 50);
-      CHECK(covered_halves(render(scene("one.glb", -3, json::object(), lit), mode)) ==
+      CHECK(covered_halves(render_mode(scene("one.glb", -3, json::object(), lit), mode, 1)) ==
             std::pair<int, int>{0, 0});
       // Per material: seen from behind (x flips on screen) only the double-sided right square
       // shows, now in the left half.
-      const auto mixed = covered_halves(render(scene("mixed.glb", -3, json::object(), lit), mode));
+      const auto mixed =
+          covered_halves(render_mode(scene("mixed.glb", -3, json::object(), lit), mode, 1));
       CHECK(mixed == std::pair<int, int>{front.second, 0});
-      CHECK(covered_halves(render(scene("both.glb", -3, json::object(), lit), mode)) ==
+      CHECK(covered_halves(render_mode(scene("both.glb", -3, json::object(), lit), mode, 1)) ==
             std::pair<int, int>{front.second, front.first});
       // A mirroring model matrix keeps the front facing +z (clockwise on screen now).
-      CHECK(covered_halves(render(scene("one.glb", 3, mirror, lit), mode)) ==
+      CHECK(covered_halves(render_mode(scene("one.glb", 3, mirror, lit), mode, 1)) ==
             std::pair<int, int>{front.second, front.first});
-      CHECK(covered_halves(render(scene("one.glb", -3, mirror, lit), mode)) ==
+      CHECK(covered_halves(render_mode(scene("one.glb", -3, mirror, lit), mode, 1)) ==
             std::pair<int, int>{0, 0});
       // The scene may make them double-sided.
       const json both_sides = {{"material", {{"double_sided", true}}}};
-      CHECK(covered_halves(render(scene("one.glb", -3, both_sides, lit), mode)).first > 50);
+      CHECK(covered_halves(render_mode(scene("one.glb", -3, both_sides, lit), mode, 1)).first > 50);
     }
   }
 }

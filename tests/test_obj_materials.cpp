@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "test_cli_run.hpp"
+#include "test_meshes.hpp"
 #include "test_tempdir.hpp"
 
 namespace fs = std::filesystem;
@@ -26,6 +27,7 @@ using Catch::Matchers::Contains;
 using covrast::Material;
 using covrast::MeshData;
 using covrast::ShadingModel;
+using covrast::test::render_mode;
 using nlohmann::json;
 
 namespace {
@@ -58,13 +60,6 @@ json scene_of(const std::string& obj, const json& mesh_extra = json::object(),
                 {"meshes", json::array({mesh})}};
   if (lights != nullptr) scene["lights"] = *lights;
   return scene;
-}
-
-covrast::Image render(const covrast::Scene& scene, const char* mode = "coverage") {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = 1;
-  return covrast::render(scene, options).color;
 }
 
 std::string load_error(const fs::path& scene) {
@@ -211,13 +206,13 @@ TEST_CASE("OBJ materials: one Kd is the uniform colour, unlit and lit alike", "[
   REQUIRE(unlit.meshes[0].color_source == covrast::ColorSource::Uniform);
   REQUIRE(unlit.meshes[0].color_linear == glm::vec3(kd));
   REQUIRE(unlit.warnings.empty());
-  const covrast::Image a = render(unlit);
-  CHECK(a.rgb == render(covrast::load_scene(dir / "unlit_without.json")).rgb);
+  const covrast::Image a = render_mode(unlit, "coverage", 1);
+  CHECK(a.rgb == render_mode(covrast::load_scene(dir / "unlit_without.json"), "coverage", 1).rgb);
   CHECK(int(a.pixel(16, 16)[0]) == 153);  // 0.6 * 255
   const covrast::Scene lit = covrast::load_scene(dir / "lit_with.json");
   REQUIRE(lit.meshes[0].materials[0].model == ShadingModel::BlinnPhong);
-  const covrast::Image b = render(lit);
-  CHECK(b.rgb == render(covrast::load_scene(dir / "lit_without.json")).rgb);
+  const covrast::Image b = render_mode(lit, "coverage", 1);
+  CHECK(b.rgb == render_mode(covrast::load_scene(dir / "lit_without.json"), "coverage", 1).rgb);
   CHECK(b.rgb != a.rgb);
 }
 
@@ -327,7 +322,7 @@ TEST_CASE("a concave OBJ polygon renders only its own pixels", "[obj][polygon]")
   dir.write("scene.json", scene_of("u.obj", {{"color", {1, 1, 1}}}).dump());
   const covrast::Scene scene = covrast::load_scene(dir / "scene.json");
   REQUIRE(scene.warnings.empty());
-  const covrast::Image image = render(scene, "aliased");
+  const covrast::Image image = render_mode(scene, "aliased", 1);
   // The camera sees [-h, h], h = 3 tan(20 deg), across the 32 pixels at z = 0; px() is the
   // column of a world x (and 31 - px() the row of a world y).
   const double half = 3.0 * std::tan(20.0 * 3.14159265358979323846 / 180.0);
@@ -410,7 +405,7 @@ TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file, missing
   CHECK(scene.warnings.empty());
   for (const char* mode : {"coverage", "aliased", "reference"}) {
     INFO(mode);
-    const covrast::Image image = render(scene, mode);
+    const covrast::Image image = render_mode(scene, mode, 1);
     // Kd 1 x the texel, unlit: the texel's own sRGB bytes in the middle of the quad.
     const std::size_t centre = 3 * (16 * 32 + 16);
     CHECK(std::abs(int(image.rgb[centre]) - 200) <= 1);
@@ -424,7 +419,7 @@ TEST_CASE("OBJ map_Kd textures the surface in sRGB, one decode per file, missing
   REQUIRE(without.warnings.size() == 1);
   CHECK_THAT(without.warnings[0], Catch::Matchers::Contains("map_Kd tex.png: no such file"));
   CHECK(without.meshes[0].mesh->materials[0].base_color_texture.texture == nullptr);
-  const covrast::Image plain = render(without, "coverage");
+  const covrast::Image plain = render_mode(without, "coverage", 1);
   const std::size_t centre = 3 * (16 * 32 + 16);
   CHECK(int(plain.rgb[centre]) == 255);
   CHECK(int(plain.rgb[centre + 1]) == 255);

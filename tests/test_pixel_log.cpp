@@ -18,6 +18,7 @@
 #include "raster/coverage/pixel_log.hpp"
 #include "test_hooks.hpp"
 #include "test_meshes.hpp"
+#include "test_splits.hpp"
 
 using covrast::detail::EdgeCrossingKeys;
 using covrast::detail::kCoverageOne;
@@ -197,14 +198,11 @@ TEST_CASE("pixel log: the same bytes for every thread count and tile size", "[co
   s.camera.eye = glm::dvec3(0.4, 0.2, 2.6);
   auto sphere = covrast::test::uv_sphere(30, 60);  // not analysed: back faces drawn too
   covrast::test::add_instance(s, sphere, glm::vec3(1), covrast::ColorSource::PerTriangle);
-  const covrast::RenderResult base = render_coverage(s, false, 1, 64);
+  const covrast::test::ScopedHook hook(covrast::detail::testing::coverage_hooks.list_only, false);
+  const covrast::RenderResult base = covrast::test::expect_same_bytes_for_every_split(
+      s, "coverage", covrast::test::every_split({1, 2, 3}, {8, 16, 32}),
+      [](const covrast::RenderResult& r, const covrast::RenderResult& b, covrast::test::Split) {
+        CHECK(r.stats.resolve_paths.masked == b.stats.resolve_paths.masked);
+      });
   CHECK(base.stats.resolve_paths.masked > 100);  // folds at the silhouette: two layers
-  for (int threads : {1, 2, 3}) {
-    for (int tile : {8, 16, 32}) {
-      INFO(threads << " threads, tile " << tile);
-      const covrast::RenderResult r = render_coverage(s, false, threads, tile);
-      CHECK(r.color.rgb == base.color.rgb);
-      CHECK(r.stats.resolve_paths.masked == base.stats.resolve_paths.masked);
-    }
-  }
 }

@@ -16,10 +16,12 @@
 #include <string>
 #include <vector>
 
+#include "test_meshes.hpp"
 #include "test_tempdir.hpp"
 
 using Catch::Matchers::Contains;
 using covrast::InputError;
+using covrast::test::render_mode;
 
 namespace {
 
@@ -74,13 +76,6 @@ std::string obj_text(const covrast::MeshArrays& a) {
   return text;
 }
 
-covrast::Image render(const covrast::Scene& scene, const char* mode) {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = 2;
-  return covrast::render(scene, options).color;
-}
-
 }  // namespace
 
 TEST_CASE("scene build: a quad covering the whole image renders its colour in every pixel",
@@ -92,7 +87,7 @@ TEST_CASE("scene build: a quad covering the whole image renders its colour in ev
   covrast::check_scene(scene);
   for (const char* mode : {"coverage", "msaa:4", "aliased", "ssaa:2"}) {
     INFO(mode);
-    const covrast::Image image = render(scene, mode);
+    const covrast::Image image = render_mode(scene, mode);
     REQUIRE(image.width == 37);
     REQUIRE(image.height == 23);
     std::size_t wrong = 0;
@@ -188,8 +183,8 @@ TEST_CASE("scene build: a scene built in memory renders byte-identically to its 
 
   for (const char* mode : {"coverage", "msaa:4"}) {
     INFO(mode);
-    const covrast::Image from_file = render(loaded, mode);
-    const covrast::Image from_memory = render(built, mode);
+    const covrast::Image from_file = render_mode(loaded, mode);
+    const covrast::Image from_memory = render_mode(built, mode);
     REQUIRE(from_memory.width == from_file.width);
     REQUIRE(from_memory.height == from_file.height);
     CHECK(from_memory.rgb == from_file.rgb);

@@ -13,6 +13,7 @@
 #include "raster/samples/sample_pattern.hpp"
 #include "raster/samples/sample_raster.hpp"
 #include "test_meshes.hpp"
+#include "test_splits.hpp"
 
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
@@ -52,6 +53,7 @@ using covrast::detail::SampleRasterizer;
 using covrast::detail::ShadingRate;
 using covrast::detail::TriangleSetup;
 using covrast::test::add_instance;
+using covrast::test::render_mode;
 using covrast::test::uv_sphere;
 
 // ---------------------------------------------------------------------------------------
@@ -684,15 +686,6 @@ Scene base_scene(int width, int height, glm::vec3 background) {
   return s;
 }
 
-covrast::RenderResult render_mode(const Scene& s, const std::string& mode, int threads = 1,
-                                  int tile = 64) {
-  RenderOptions o;
-  o.mode = covrast::parse_render_mode(mode);
-  o.threads = threads;
-  o.tile = tile;
-  return covrast::render(s, o);
-}
-
 }  // namespace
 
 TEST_CASE("seam scene: a closed sphere in the background colour renders exactly flat", "[ssaa]") {
@@ -705,7 +698,7 @@ TEST_CASE("seam scene: a closed sphere in the background colour renders exactly 
   // The sphere is really there: in white it covers a good part of the image.
   Scene white = s;
   white.meshes[0].color_linear = glm::vec3(1.0f);
-  const Image lit = render_mode(white, "ssaa:4").color;
+  const Image lit = render_mode(white, "ssaa:4", 1);
   int covered = 0;
   for (std::size_t i = 0; i < lit.rgb.size(); i += 3) covered += lit.rgb[i] == 255;
   REQUIRE(covered > 64 * 64 / 4);
@@ -713,7 +706,7 @@ TEST_CASE("seam scene: a closed sphere in the background colour renders exactly 
     INFO(mode);
     Scene scene = s;
     if (std::string(mode) == "reference") scene.width = scene.height = 40;
-    const Image img = render_mode(scene, mode, 2).color;
+    const Image img = render_mode(scene, mode, 2);
     const std::uint8_t* first = img.pixel(0, 0);
     int off = 0;
     for (int y = 0; y < img.height; ++y) {
@@ -892,21 +885,18 @@ TEST_CASE(
     INFO(mode);
     const bool reference = std::string(mode) == "reference";
     const Scene& s = reference ? small : scene;
-    const Image base = render_mode(s, mode, 1, 64).color;
     // Tiles 8 and 24 start off the 16-pixel group grid of ssaa:1.
-    for (auto [threads, tile] :
-         {std::pair{2, 16}, std::pair{2, 64}, std::pair{2, 128}, std::pair{1, 16},
-          std::pair{1, 128}, std::pair{2, 8}, std::pair{2, 24}}) {
-      INFO("threads " << threads << ", tile " << tile);
-      REQUIRE(render_mode(s, mode, threads, tile).color.rgb == base.rgb);
-    }
+    const Image base =
+        covrast::test::expect_same_bytes_for_every_split(
+            s, mode, {{2, 16}, {2, 64}, {2, 128}, {1, 16}, {1, 128}, {2, 8}, {2, 24}})
+            .color;
     if (reference) continue;  // no SIMD kernels in the reference mode
     for (std::int64_t bits = targets; bits != 0; bits &= bits - 1) {
       const std::int64_t target = bits & -bits;
       INFO("target " << hwy::TargetName(target));
       const Image img = [&] {
         const covrast::test::ScopedSimdTarget forced(target);
-        return render_mode(s, mode, 2, 64).color;
+        return render_mode(s, mode, 2, 64);
       }();
       REQUIRE(img.rgb == base.rgb);
       ++forced;
@@ -928,7 +918,7 @@ TEST_CASE(
   REQUIRE(std::unique(kernels.begin(), kernels.end()) - kernels.begin() ==
           std::ptrdiff_t(kernels.size()));
   // The picture is not trivial: most of it is covered, in many colours.
-  const Image img = render_mode(scene, "ssaa:4").color;
+  const Image img = render_mode(scene, "ssaa:4", 1);
   std::vector<std::uint32_t> colors;
   for (std::size_t i = 0; i < img.rgb.size(); i += 3) {
     colors.push_back(std::uint32_t(img.rgb[i]) << 16 | std::uint32_t(img.rgb[i + 1]) << 8 |

@@ -25,6 +25,7 @@
 
 #include "test_gltf_files.hpp"
 #include "test_meshes.hpp"
+#include "test_splits.hpp"
 #include "test_tempdir.hpp"
 
 using Catch::Matchers::Contains;
@@ -489,13 +490,8 @@ TEST_CASE("textures: the same bytes for every thread count and tile size", "[tex
                           covrast::MipFilter::Linear),
                   160, 120);
   for (const char* mode : {"coverage", "aliased", "ssaa:2", "msaa:4"}) {
-    INFO(mode);
-    const covrast::Image first = render_mode(scene, mode, 1, 64);
-    for (const int threads : {2, 4}) {
-      for (const int tile : {8, 32, 256}) {
-        REQUIRE(render_mode(scene, mode, threads, tile).rgb == first.rgb);
-      }
-    }
+    covrast::test::expect_same_bytes_for_every_split(
+        scene, mode, covrast::test::every_split({2, 4}, {8, 32, 256}));
   }
 }
 

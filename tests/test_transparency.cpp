@@ -21,7 +21,11 @@
 
 #include "core/testing_hooks.hpp"
 #include "test_gltf_files.hpp"
+#include "test_meshes.hpp"
+#include "test_splits.hpp"
 #include "test_tempdir.hpp"
+
+using covrast::test::render_mode;
 
 namespace {
 
@@ -66,15 +70,6 @@ covrast::Material material(covrast::AlphaMode mode, double base_alpha, double cu
   m.base_alpha = base_alpha;
   m.alpha_cutoff = cutoff;
   return m;
-}
-
-covrast::Image render(const covrast::Scene& scene, const std::string& mode, int threads = 1,
-                      int tile = 64) {
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode(mode);
-  options.threads = threads;
-  options.tile = tile;
-  return covrast::render(scene, options).color;
 }
 
 int max_difference(const covrast::Image& a, const covrast::Image& b) {
@@ -162,8 +157,8 @@ TEST_CASE("BLEND quads composite in depth order whatever the draw order", "[tran
   int orders = 0;
   do {
     const covrast::Scene scene = blend_quads(order);
-    const covrast::Image coverage = render(scene, "coverage");
-    const covrast::Image reference = render(scene, "reference");
+    const covrast::Image coverage = render_mode(scene, "coverage", 1);
+    const covrast::Image reference = render_mode(scene, "reference", 1);
     if (orders == 0) {
       first_coverage = coverage;
       first_reference = reference;
@@ -190,8 +185,8 @@ TEST_CASE("A BLEND surface partly covering a pixel over an opaque edge", "[trans
   covrast::add_instance(scene, rect(10.5, 0, 32, 32, 1.0),
                         {.material = material(covrast::AlphaMode::Blend, alpha)})
       .color_linear = glm::vec3(clear_color);
-  const covrast::Image coverage = render(scene, "coverage");
-  const covrast::Image reference = render(scene, "reference");
+  const covrast::Image coverage = render_mode(scene, "coverage", 1);
+  const covrast::Image reference = render_mode(scene, "reference", 1);
   // Quarters: top-left background, bottom-left opaque, top-right clear over background,
   // bottom-right clear over opaque.
   const glm::dvec3 expected =
@@ -234,8 +229,8 @@ TEST_CASE("Slanted BLEND edges over opaque edges match the per-sample reference"
       .color_linear = {0.9f, 0.9f, 0.2f};
   covrast::add_instance(scene, triangle({20.2, 15.5}, {31.0, 30.0}, {14.0, 29.5}, 1.0))
       .color_linear = {0.6f, 0.3f, 0.7f};
-  const covrast::Image coverage = render(scene, "coverage");
-  const covrast::Image reference = render(scene, "reference");
+  const covrast::Image coverage = render_mode(scene, "coverage", 1);
+  const covrast::Image reference = render_mode(scene, "reference", 1);
   REQUIRE(max_difference(coverage, reference) <= 2);
 }
 
@@ -253,7 +248,7 @@ TEST_CASE("MASK keeps alpha at and above the cutoff, drops below", "[transparenc
         .color_linear = {1.0f, 1.0f, 1.0f};
     for (const char* mode :
          {"coverage", "coverage-blend", "reference", "aliased", "msaa:4", "ssaa:4"}) {
-      const covrast::Image image = render(scene, mode);
+      const covrast::Image image = render_mode(scene, mode, 1);
       INFO(mode << " alpha " << c.alpha);
       REQUIRE(image.pixel(16, 16)[0] == (c.kept ? 255 : 0));
       REQUIRE(image.pixel(2, 2)[0] == 0);
@@ -269,7 +264,7 @@ TEST_CASE("MASK with a vertex alpha ramp: kept where the centre's alpha passes",
                         {.material = material(covrast::AlphaMode::Mask, 1.0, 0.5)})
       .color_linear = {1.0f, 1.0f, 1.0f};
   for (const char* mode : {"coverage", "reference", "aliased", "msaa:4", "ssaa:4"}) {
-    const covrast::Image image = render(scene, mode);
+    const covrast::Image image = render_mode(scene, mode, 1);
     for (int x = 0; x < kSide; ++x) {
       INFO(mode << " x " << x);
       REQUIRE(image.pixel(x, 10)[0] == (x >= 16 ? 255 : 0));
@@ -284,7 +279,7 @@ TEST_CASE("Vertex alpha and base colour alpha multiply", "[transparency]") {
       .color_linear = {1.0f, 0.0f, 0.0f};
   const glm::dvec3 expected = 0.25 * glm::dvec3(1.0, 0.0, 0.0) + 0.75 * kBackground;
   for (const char* mode : {"coverage", "reference", "aliased", "msaa:4", "ssaa:4"}) {
-    const covrast::Image image = render(scene, mode);
+    const covrast::Image image = render_mode(scene, mode, 1);
     INFO(mode);
     REQUIRE(image.pixel(16, 16)[0] == code(expected.r));
     REQUIRE(image.pixel(16, 16)[1] == code(expected.g));
@@ -321,18 +316,6 @@ covrast::Scene random_transparent_scene() {
   return scene;
 }
 
-/// `mode` renders `scene` to the same bytes on 2 and 3 threads with tiles of 8 to 256 pixels
-/// as on 1 thread with 64-pixel tiles.
-void require_same_bytes_over_threads_and_tiles(const covrast::Scene& scene, const char* mode) {
-  const covrast::Image base = render(scene, mode, 1, 64);
-  for (const int threads : {2, 3}) {
-    for (const int tile : {8, 16, 24, 256}) {
-      INFO(mode << " threads " << threads << " tile " << tile);
-      REQUIRE(render(scene, mode, threads, tile).rgb == base.rgb);
-    }
-  }
-}
-
 }  // namespace
 
 // Split in two so that the TSan step (scripts/tsan.sh, the [threads] tests) runs the modes
@@ -341,7 +324,7 @@ TEST_CASE("Transparency gives the same bytes for every thread count and tile siz
           "[transparency][threads]") {
   const covrast::Scene scene = random_transparent_scene();
   for (const char* mode : {"coverage", "msaa:4", "ssaa:4", "aliased"}) {
-    require_same_bytes_over_threads_and_tiles(scene, mode);
+    covrast::test::expect_same_bytes_for_every_split(scene, mode);
   }
 }
 
@@ -349,7 +332,7 @@ TEST_CASE("Transparency gives the same bytes for every thread count and tile siz
 // supersampling tests, and its transparent composite in the other tests of this file.
 TEST_CASE("Transparency gives the same bytes for every thread count and tile size: reference",
           "[transparency][sanitizer-slow]") {
-  require_same_bytes_over_threads_and_tiles(random_transparent_scene(), "reference");
+  covrast::test::expect_same_bytes_for_every_split(random_transparent_scene(), "reference");
 }
 
 TEST_CASE("A closed BLEND mesh shows its back faces", "[transparency]") {
@@ -372,7 +355,7 @@ TEST_CASE("A closed BLEND mesh shows its back faces", "[transparency]") {
       .color_linear = {1.0f, 1.0f, 1.0f};
   for (const char* mode : {"coverage", "reference", "aliased", "msaa:4", "ssaa:4"}) {
     INFO(mode);
-    REQUIRE(render(scene, mode).pixel(16, 16)[0] == code(0.75));
+    REQUIRE(render_mode(scene, mode, 1).pixel(16, 16)[0] == code(0.75));
   }
 }
 
@@ -459,11 +442,11 @@ TEST_CASE("The uniform-layer shortcut gives what the per-sample composite gives"
   // Interior pixels of the three quads take the shortcut; with the mask resolve forced they
   // take the 256-sample composite of the general formula.
   const covrast::Scene scene = blend_quads({2, 0, 1});
-  const covrast::Image fast = render(scene, "coverage");
+  const covrast::Image fast = render_mode(scene, "coverage", 1);
   const covrast::Image samples = [&] {
     const covrast::test::ScopedHook masks_only(
         covrast::detail::testing::coverage_hooks.mask_resolve, true);
-    return render(scene, "coverage");
+    return render_mode(scene, "coverage", 1);
   }();
   REQUIRE(max_difference(fast, samples) <= 1);
 }
@@ -491,8 +474,8 @@ TEST_CASE("Lit BLEND and MASK surfaces composite like unlit ones", "[transparenc
   cut.alpha_cutoff = 0.5;
   covrast::add_instance(scene, rect(2, 2, 9, 30, 1.5, {0.0f, 1.0f, 1.0f, 0.0f}), {.material = cut})
       .color_linear = {0.7f, 0.7f, 0.7f};
-  const covrast::Image coverage = render(scene, "coverage");
-  const covrast::Image reference = render(scene, "reference");
+  const covrast::Image coverage = render_mode(scene, "coverage", 1);
+  const covrast::Image reference = render_mode(scene, "reference", 1);
   // The MASK ramp's cut is per pixel in coverage, per sample in the reference: compare away
   // from its pixel column.
   int worst = 0;
