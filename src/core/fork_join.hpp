@@ -7,11 +7,20 @@
 // call returns. Tasks of one loop are not ordered among themselves. That order is made by
 // the scheduler inside libtbb.so, and Debian's libtbb.so is not built with TSan, so a TSan
 // build sees none of it and reports every value handed to or from a task as a race. Here the
-// two edges are announced by hand with two sync objects per call: `fork` (released by the
-// caller before the loop, acquired at the start of each task) and `join` (released at the
-// end of each task, acquired by the caller after the loop). No task acquires `join`, so one
-// task's writes are never ordered before another's reads: a real race between tasks (two
-// tiles writing one pixel) is still reported. Outside a TSan build the annotations are empty.
+// two edges are announced by hand:
+// - fork: the caller releases `fork_sync` once the tasks' closure is built, just before the
+//   loop; each task acquires it before it reads anything of the caller's. There is one fork
+//   object for the whole program because a task could learn a per-call address only by
+//   reading the caller's closure, and that read is what needs the edge: a new worker thread
+//   that had synchronised with nothing yet read the closure on the caller's stack first, and
+//   TSan reported it (CI, 2026-12-04).
+// - join: one sync object per call, released at the end of each task (after its acquire of
+//   `fork_sync`, so reading the closure is ordered) and acquired by the caller after the loop.
+// No task acquires `join`, so the tasks of one loop are not ordered among themselves and a
+// real race between them (two tiles writing one pixel) is still reported. The one exception
+// is the price of the single fork object: a task that starts a nested loop releases it, so
+// its writes so far are ordered before every task that starts after that, and a race with
+// such a task can go unreported. Outside a TSan build the annotations are empty.
 #pragma once
 
 #include <oneapi/tbb/global_control.h>
@@ -36,15 +45,21 @@
 
 namespace covrast::detail {
 
+/// The sync object of every call's fork edge (see above).
+inline char fork_sync = 0;
+
 /// The two happens-before edges of one fork-join call (see above).
 class ForkJoinOrder {
  public:
-  /// Before the tasks start: the caller's writes so far reach every task.
-  ForkJoinOrder() { release(&fork_); }
+  ForkJoinOrder() = default;
   ForkJoinOrder(const ForkJoinOrder&) = delete;
   ForkJoinOrder& operator=(const ForkJoinOrder&) = delete;
-  /// At the start of a task.
-  void enter_task() const { acquire(&fork_); }
+  /// Just before the loop, after the tasks' closure is built: the caller's writes so far
+  /// reach every task.
+  static void fork() { release(&fork_sync); }
+  /// At the start of a task, before it reads the closure: static, so that calling it reads
+  /// nothing of the caller's.
+  static void enter_task() { acquire(&fork_sync); }
   /// At the end of a task.
   void leave_task() const { release(&join_); }
   /// After the call returned: every task's writes reach the caller.
@@ -58,7 +73,6 @@ class ForkJoinOrder {
   static void release(const void*) {}
   static void acquire(const void*) {}
 #endif
-  char fork_ = 0;
   char join_ = 0;
 };
 
@@ -83,11 +97,13 @@ class ThreadAllowance {
 template <class Range, class Body>
 void fork_join_for(const Range& range, const Body& body) {
   const ForkJoinOrder order;
-  tbb::parallel_for(range, [&](const Range& r) {
-    order.enter_task();
+  const auto task = [&](const Range& r) {
+    ForkJoinOrder::enter_task();
     body(r);
     order.leave_task();
-  });
+  };
+  ForkJoinOrder::fork();
+  tbb::parallel_for(range, task);
   order.joined();
 }
 
@@ -95,11 +111,13 @@ void fork_join_for(const Range& range, const Body& body) {
 template <class Index, class Body>
 void fork_join_for(Index first, Index last, const Body& body) {
   const ForkJoinOrder order;
-  tbb::parallel_for(first, last, [&](Index i) {
-    order.enter_task();
+  const auto task = [&](Index i) {
+    ForkJoinOrder::enter_task();
     body(i);
     order.leave_task();
-  });
+  };
+  ForkJoinOrder::fork();
+  tbb::parallel_for(first, last, task);
   order.joined();
 }
 
@@ -108,11 +126,13 @@ void fork_join_for(Index first, Index last, const Body& body) {
 template <class Work>
 void fork_join_execute(tbb::task_arena& arena, const Work& work) {
   const ForkJoinOrder order;
-  arena.execute([&] {
-    order.enter_task();
+  const auto task = [&] {
+    ForkJoinOrder::enter_task();
     work();
     order.leave_task();
-  });
+  };
+  ForkJoinOrder::fork();
+  arena.execute(task);
   order.joined();
 }
 
