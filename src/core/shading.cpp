@@ -361,7 +361,8 @@ bool mask_keeps(const TriangleSetup& t, double x_px, double y_px, bool clamp_ins
   return surface_alpha(t, mu[0], mu[1], mu[2]) >= t.shading->surface->alpha_cutoff;
 }
 
-glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
+                    const FootprintTaps* taps) {
   const ShadingRecord& r = *t.shading;
   // The same weighted sums as the unlit colour interpolation in shade().
   const glm::dvec3 base(mu0 * t.color[0].r + mu1 * t.color[1].r + mu2 * t.color[2].r,
@@ -380,7 +381,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2) 
   };
   if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n, n));
   // Textured: the surface with this point's texels (core/texture_shading.cpp).
-  const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n);
+  const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n, taps);
   SurfaceShading s = *r.surface;
   s.metallic = sample.metallic;
   s.roughness = sample.roughness;

@@ -68,6 +68,17 @@ struct SurfaceTextures {
   const TextureSlot* sheen_roughness = nullptr;        ///< KHR_materials_sheen, A
   const TextureSlot* iridescence = nullptr;            ///< KHR_materials_iridescence, R
   const TextureSlot* iridescence_thickness = nullptr;  ///< KHR_materials_iridescence, G
+  /// Some slot filters NEAREST within a mip level (magnification or minification): coverage
+  /// mode averages such slots over the fragment (raster/coverage/fragment_shading.hpp).
+  bool nearest_filtered = false;
+};
+
+/// Points of one pixel, as perspective-correct weights, over which sample_surface averages
+/// the NEAREST-filtered textures (raster/coverage/fragment_shading.hpp makes them).
+struct FootprintTaps {
+  static constexpr int kMax = 16;  ///< 4 x 4, raster/coverage/fragment_shading.cpp
+  double mu[kMax][3];
+  int count = 0;
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -151,8 +162,10 @@ struct SurfaceSample {
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
 /// the level of detail from the exact screen-space derivatives of each UV set there;
 /// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
+/// With `taps` (count > 0), a NEAREST-filtered slot is the mean of its lookups at the taps'
+/// weights, each at the level of detail of mu0..mu2.
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                             const glm::dvec3& normal);
+                             const glm::dvec3& normal, const FootprintTaps* taps = nullptr);
 
 /// The base colour texture's filtered alpha at the weights mu0..mu2 (1 without one): the
 /// texture term of surface_alpha, sampled exactly as sample_surface samples it.

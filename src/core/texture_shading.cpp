@@ -43,9 +43,10 @@ WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double 
 namespace {
 
 /// One slot's filtered texel: its UV set at the point, transformed, with the level of detail
-/// of the transformed derivatives.
+/// of the transformed derivatives. A NEAREST-filtered slot with `taps`: the mean of the
+/// lookups at the taps' weights, at that level of detail.
 glm::dvec4 lookup(const TextureSlot& slot, const TexturedCorners& corners, const double mu[3],
-                  const WeightDerivatives& d) {
+                  const WeightDerivatives& d, const FootprintTaps* taps) {
   // check_scene refuses other sets; a scene built without it must still not read out of bounds.
   const glm::vec2* uv = corners.uv[slot.texcoord == 1 ? 1 : 0];
   glm::dvec2 p(0.0), dx(0.0), dy(0.0);
@@ -54,10 +55,20 @@ glm::dvec4 lookup(const TextureSlot& slot, const TexturedCorners& corners, const
     dx += d.dx[k] * glm::dvec2(uv[k]);
     dy += d.dy[k] * glm::dvec2(uv[k]);
   }
-  p = transform_uv(slot.transform, p);
   dx = transform_duv(slot.transform, dx);
   dy = transform_duv(slot.transform, dy);
-  return sample_texture(*slot.texture, slot.sampler, p, texture_lod(*slot.texture, dx, dy));
+  const double lod = texture_lod(*slot.texture, dx, dy);
+  const TextureFilter filter = lod > 0.0 ? slot.sampler.min : slot.sampler.mag;
+  if (taps == nullptr || taps->count == 0 || filter != TextureFilter::Nearest) {
+    return sample_texture(*slot.texture, slot.sampler, transform_uv(slot.transform, p), lod);
+  }
+  glm::dvec4 sum(0.0);
+  for (int i = 0; i < taps->count; ++i) {
+    glm::dvec2 q(0.0);
+    for (int k = 0; k < 3; ++k) q += taps->mu[i][k] * glm::dvec2(uv[k]);
+    sum += sample_texture(*slot.texture, slot.sampler, transform_uv(slot.transform, q), lod);
+  }
+  return sum / double(taps->count);
 }
 
 /// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
@@ -86,31 +97,34 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
 /// mapped one); each multiplies the surface's factor.
 void sample_material_extensions(const SurfaceShading& s, const SurfaceTextures& slots,
                                 const TexturedCorners& corners, const double mu[3],
-                                const WeightDerivatives& d, SurfaceSample& out) {
-  if (slots.specular != nullptr) out.specular_weight *= lookup(*slots.specular, corners, mu, d).a;
+                                const WeightDerivatives& d, const FootprintTaps* taps,
+                                SurfaceSample& out) {
+  if (slots.specular != nullptr)
+    out.specular_weight *= lookup(*slots.specular, corners, mu, d, taps).a;
   if (slots.specular_color != nullptr) {
-    out.specular_color *= glm::dvec3(lookup(*slots.specular_color, corners, mu, d));
+    out.specular_color *= glm::dvec3(lookup(*slots.specular_color, corners, mu, d, taps));
   }
-  if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d).r;
+  if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d, taps).r;
   if (slots.clearcoat_roughness != nullptr) {
-    out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d).g;
+    out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d, taps).g;
   }
-  if (slots.iridescence != nullptr) out.iridescence *= lookup(*slots.iridescence, corners, mu, d).r;
+  if (slots.iridescence != nullptr)
+    out.iridescence *= lookup(*slots.iridescence, corners, mu, d, taps).r;
   if (slots.iridescence_thickness != nullptr) {
-    const double g = lookup(*slots.iridescence_thickness, corners, mu, d).g;
+    const double g = lookup(*slots.iridescence_thickness, corners, mu, d, taps).g;
     out.iridescence_thickness_nm =
         s.iridescence_thickness_min_nm +
         (s.iridescence_thickness_nm - s.iridescence_thickness_min_nm) * g;
   }
   if (slots.sheen_color != nullptr) {
-    out.sheen_color *= glm::dvec3(lookup(*slots.sheen_color, corners, mu, d));
+    out.sheen_color *= glm::dvec3(lookup(*slots.sheen_color, corners, mu, d, taps));
   }
   if (slots.sheen_roughness != nullptr) {
-    out.sheen_roughness *= lookup(*slots.sheen_roughness, corners, mu, d).a;
+    out.sheen_roughness *= lookup(*slots.sheen_roughness, corners, mu, d, taps).a;
   }
   if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
     out.clearcoat_normal =
-        perturbed_normal(lookup(*slots.clearcoat_normal, corners, mu, d),
+        perturbed_normal(lookup(*slots.clearcoat_normal, corners, mu, d, taps),
                          slots.clearcoat_normal->scale, corners, mu, out.clearcoat_normal);
   }
 }
@@ -122,12 +136,12 @@ double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, 
   if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return 1.0;
   const double mu[3] = {mu0, mu1, mu2};
   return lookup(*r.surface->textures->base_color, *r.textured, mu,
-                weight_derivatives(t, mu0, mu1, mu2))
+                weight_derivatives(t, mu0, mu1, mu2), nullptr)
       .a;
 }
 
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                             const glm::dvec3& normal) {
+                             const glm::dvec3& normal, const FootprintTaps* taps) {
   const ShadingRecord& r = *t.shading;
   const SurfaceShading& s = *r.surface;
   const SurfaceTextures& slots = *s.textures;
@@ -148,24 +162,24 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.iridescence_thickness_nm = s.iridescence_thickness_nm;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
-  if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d);
+  if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d, taps);
   if (slots.metallic_roughness != nullptr) {
-    const glm::dvec4 v = lookup(*slots.metallic_roughness, corners, mu, d);
+    const glm::dvec4 v = lookup(*slots.metallic_roughness, corners, mu, d, taps);
     out.roughness *= v.g;
     out.metallic *= v.b;
   }
   if (slots.occlusion != nullptr) {
-    const glm::dvec4 v = lookup(*slots.occlusion, corners, mu, d);
+    const glm::dvec4 v = lookup(*slots.occlusion, corners, mu, d, taps);
     out.occlusion = 1.0 + double(slots.occlusion->scale) * (v.r - 1.0);
   }
   if (slots.emissive != nullptr) {
-    out.emissive *= glm::dvec3(lookup(*slots.emissive, corners, mu, d));
+    out.emissive *= glm::dvec3(lookup(*slots.emissive, corners, mu, d, taps));
   }
   if (slots.normal != nullptr && normal != glm::dvec3(0.0)) {
-    out.normal = perturbed_normal(lookup(*slots.normal, corners, mu, d), slots.normal->scale,
+    out.normal = perturbed_normal(lookup(*slots.normal, corners, mu, d, taps), slots.normal->scale,
                                   corners, mu, normal);
   }
-  sample_material_extensions(s, slots, corners, mu, d, out);
+  sample_material_extensions(s, slots, corners, mu, d, taps, out);
   return out;
 }
 

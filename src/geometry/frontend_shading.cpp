@@ -40,7 +40,7 @@ PunctualLight punctual_light(const Light& light) {
 
 /// The texture slots a material shows: all of them when it is lit, only the base colour's
 /// when unlit (ShadingModel::Unlit, or a scene without lights).
-SurfaceTextures surface_textures(const Material& m, bool lit) {
+SurfaceTextures surface_slots(const Material& m, bool lit) {
   const auto slot = [](const TextureSlot& t) { return t ? &t : nullptr; };
   SurfaceTextures out;
   out.base_color = slot(m.base_color_texture);
@@ -59,6 +59,38 @@ SurfaceTextures surface_textures(const Material& m, bool lit) {
   out.sheen_roughness = slot(m.sheen_roughness_texture);
   out.iridescence = slot(m.iridescence_texture);
   out.iridescence_thickness = slot(m.iridescence_thickness_texture);
+  return out;
+}
+
+/// Whether some slot of `t` filters NEAREST within a mip level.
+bool any_nearest_filtered(const SurfaceTextures& t) {
+  const TextureSlot* const slots[] = {t.base_color,
+                                      t.metallic_roughness,
+                                      t.normal,
+                                      t.occlusion,
+                                      t.emissive,
+                                      t.specular,
+                                      t.specular_color,
+                                      t.clearcoat,
+                                      t.clearcoat_roughness,
+                                      t.clearcoat_normal,
+                                      t.sheen_color,
+                                      t.sheen_roughness,
+                                      t.iridescence,
+                                      t.iridescence_thickness};
+  for (const TextureSlot* slot : slots) {
+    if (slot != nullptr && (slot->sampler.min == TextureFilter::Nearest ||
+                            slot->sampler.mag == TextureFilter::Nearest)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+/// The slots with the flag of coverage mode's averaged lookups set.
+SurfaceTextures surface_textures(const Material& m, bool lit) {
+  SurfaceTextures out = surface_slots(m, lit);
+  out.nearest_filtered = any_nearest_filtered(out);
   return out;
 }
 

@@ -43,10 +43,10 @@
 //    behind, or the background.
 #pragma once
 
-#include "core/shading.hpp"
 #include "core/tile_raster.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/pixel_log.hpp"
 #include "raster/coverage/sample_mask.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
@@ -584,7 +584,7 @@ inline void ABufferTile::add_to_sums(std::size_t pixel, int x, int y, const Tria
   } else if (sums.convex_key != convex_key(t)) {
     sums.convex_key = kNoConvexKey;
   }
-  const glm::vec3 c = shade(t, x + 0.5, y + 0.5, true);
+  const glm::vec3 c = shade_fragment(t, x, y);
   sums.coverage += coverage;
   sums.rgb[0] += double(coverage) * c.r;
   sums.rgb[1] += double(coverage) * c.g;

@@ -4,8 +4,8 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "core/checks.hpp"
-#include "core/shading.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 
 #include <algorithm>
 
@@ -19,7 +19,7 @@ void ABufferTile::merge_into(std::uint32_t f, const TriangleSetup& t, std::uint3
     merged_slot_[f] = std::uint32_t(merged_.size());
     const std::uint32_t own = fragment.coverage & kCoverageBits;
     merged_.push_back(MergedPiece{pixel_sample_mask(*fragment.triangle, x, y),
-                                  shade(*fragment.triangle, x + 0.5, y + 0.5, true),
+                                  shade_fragment(*fragment.triangle, x, y),
                                   own,
                                   1,
                                   {fragment.triangle}});
@@ -28,7 +28,7 @@ void ABufferTile::merge_into(std::uint32_t f, const TriangleSetup& t, std::uint3
   m.mask |= pixel_sample_mask(t, x, y);
   m.piece[m.pieces++] = &t;
   // Running coverage-weighted mean of the pieces' colours.
-  const glm::vec3 color = shade(t, x + 0.5, y + 0.5, true);
+  const glm::vec3 color = shade_fragment(t, x, y);
   const std::uint32_t weight = m.weight + coverage;
   if (weight > 0) {
     m.color = (m.color * float(m.weight) + color * float(coverage)) / float(weight);

@@ -1,9 +1,9 @@
 // Raster stage, coverage mode: the resolve of pixels that logged their fragments
 // (pixel_log.hpp), and the hand-over of a log to the fragment list.
 #include "core/checks.hpp"
-#include "core/shading.hpp"
 #include "raster/coverage/abuffer.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/sample_mask.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
 
@@ -203,8 +203,7 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
       log_.farthest(pixel) < opaque_near) {
     ++paths_.proven_layer;
     const LayerSums sums = logged_sums(pixel);
-    const glm::vec3 behind =
-        opaque != nullptr ? shade(*opaque, x + 0.5, y + 0.5, true) : background;
+    const glm::vec3 behind = opaque != nullptr ? shade_fragment(*opaque, x, y) : background;
     color_[pixel] = front_layer_color(sums, behind);
     depth_[pixel] = opaque != nullptr ? std::min(sums.depth, float(opaque_z_[pixel])) : sums.depth;
     return;
@@ -264,7 +263,7 @@ void ABufferTile::resolve_masked(std::size_t pixel, int x, int y, glm::vec3 back
                   "a fragment's visible weight lies between 0 and its exact area");
     depth = std::min(depth, float(p.centre_z[i]));
     if (p.weight[i] == 0.0) continue;
-    rgb += p.weight[i] * scale * glm::dvec3(shade(*p.tri[i], x + 0.5, y + 0.5, true));
+    rgb += p.weight[i] * scale * glm::dvec3(shade_fragment(*p.tri[i], x, y));
   }
   color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(background));
   depth_[pixel] = depth;

@@ -4,10 +4,10 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "core/checks.hpp"
-#include "core/shading.hpp"
 #include "core/srgb8.hpp"
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
 
 #include <algorithm>
@@ -28,7 +28,7 @@ glm::vec3 opaque_pixel(const TriangleSetup* opaque, int x, int y, glm::vec3 back
   const double cx = x + 0.5, cy = y + 0.5;
   depth =
       opaque != nullptr ? float(opaque->depth_at(cx, cy)) : std::numeric_limits<float>::infinity();
-  return opaque != nullptr ? shade(*opaque, cx, cy, true) : background;
+  return opaque != nullptr ? shade_fragment(*opaque, x, y) : background;
 }
 
 /// Whether two fragments are pieces of one layer of a surface: same mesh instance and facing,
@@ -225,7 +225,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
     for (int i = 0; i < n; ++i) {
       if (member != nullptr && !member[i]) continue;
-      const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+      const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
       const double w = double(cov[i]) * keep(tri[i]);
       sums.coverage += cov[i];
       sums.rgb[0] += w * c.r;
@@ -285,7 +285,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
   for (int i = 0; i < n; ++i) {
     if (weight[i] == 0) continue;
-    const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade(*tri[i], cx, cy, true);
+    const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
     double w = weight[i] * scale * keep(tri[i]);
     r += w * c.r;
     g += w * c.g;

@@ -2,8 +2,8 @@
 // samples at the sample masks' positions (ABufferTile::PixelSamples), and their resolve.
 #include "raster/coverage/abuffer.hpp"
 
-#include "core/shading.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/sample_depth.hpp"
 
 #include <algorithm>
@@ -140,7 +140,7 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
   double r = background_share * background.r, g = background_share * background.g,
          b = background_share * background.b;
   for (int k = 0; k < winners; ++k) {
-    const glm::vec3 c = shade(*winner[k], x + 0.5, y + 0.5, true);
+    const glm::vec3 c = shade_fragment(*winner[k], x, y);
     const double w = weight[k] * scale * (tr != nullptr ? tr->of(winner[k]) : 1.0);
     r += w * c.r;
     g += w * c.g;

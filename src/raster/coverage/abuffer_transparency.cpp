@@ -19,9 +19,9 @@
 // Everything is per pixel and sorted by depth, so draw order does not matter.
 #include "raster/coverage/abuffer.hpp"
 
-#include "core/shading.hpp"
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -148,7 +148,7 @@ glm::vec3 ABufferTile::opaque_through(std::size_t pixel, int x, int y, glm::vec3
   const TriangleSetup* o = opaque_[pixel];
   depth =
       o != nullptr ? float(o->depth_at(x + 0.5, y + 0.5)) : std::numeric_limits<float>::infinity();
-  return (o != nullptr ? shade(*o, x + 0.5, y + 0.5, true) : background) * float(tr.of(o));
+  return (o != nullptr ? shade_fragment(*o, x, y) : background) * float(tr.of(o));
 }
 
 glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,

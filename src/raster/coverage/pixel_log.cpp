@@ -2,8 +2,8 @@
 #include "raster/coverage/pixel_log.hpp"
 
 #include "core/checks.hpp"
-#include "core/shading.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -125,7 +125,7 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   const bool was_convex = convex_[pixel] != kNotConvex;
   if (convex_[pixel] != convex_key(t)) convex_[pixel] = kNotConvex;
   // The running sums of a layer, as the list's open set keeps them (the same order and bits).
-  const glm::vec3 c = shade(t, x + 0.5, y + 0.5, true);
+  const glm::vec3 c = shade_fragment(t, x, y);
   LayerColor& sums = sums_[pixel];
   sums.rgb[0] += double(coverage) * c.r;
   sums.rgb[1] += double(coverage) * c.g;
