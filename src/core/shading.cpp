@@ -362,7 +362,7 @@ bool mask_keeps(const TriangleSetup& t, double x_px, double y_px, bool clamp_ins
 }
 
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                    const FootprintTaps* taps) {
+                    const FragmentFootprint* footprint) {
   const ShadingRecord& r = *t.shading;
   // The same weighted sums as the unlit colour interpolation in shade().
   const glm::dvec3 base(mu0 * t.color[0].r + mu1 * t.color[1].r + mu2 * t.color[2].r,
@@ -381,7 +381,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
   };
   if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n, n));
   // Textured: the surface with this point's texels (core/texture_shading.cpp).
-  const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n, taps);
+  const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n, footprint);
   SurfaceShading s = *r.surface;
   s.metallic = sample.metallic;
   s.roughness = sample.roughness;

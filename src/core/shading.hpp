@@ -9,14 +9,15 @@
 
 namespace covrast::detail {
 
-struct FootprintTaps;
+struct FragmentFootprint;
 
 /// The lit colour of `t` at the perspective-correct barycentric weights mu0..mu2 (summing
 /// to 1): base colour, position and normal interpolated with them (the normal renormalised),
-/// then the material's lighting (core/shading.cpp). Out of line: it is the slow path. `taps`:
-/// where NEAREST-filtered textures are averaged (sample_surface, core/shading_inputs.hpp).
+/// then the material's lighting (core/shading.cpp). Out of line: it is the slow path.
+/// `footprint`: where NEAREST-filtered textures are averaged (sample_surface,
+/// core/shading_inputs.hpp).
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                    const FootprintTaps* taps = nullptr);
+                    const FragmentFootprint* footprint = nullptr);
 
 /// The perspective-correct barycentric weights mu0..mu2 of `t` at (x_px, y_px). With
 /// `clamp_inside`, the screen barycentrics are clamped to [0, 1] first, so a point outside the

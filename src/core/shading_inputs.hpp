@@ -73,12 +73,15 @@ struct SurfaceTextures {
   bool nearest_filtered = false;
 };
 
-/// Points of one pixel, as perspective-correct weights, over which sample_surface averages
-/// the NEAREST-filtered textures (raster/coverage/fragment_shading.hpp makes them).
-struct FootprintTaps {
-  static constexpr int kMax = 16;  ///< 4 x 4, raster/coverage/fragment_shading.cpp
-  double mu[kMax][3];
-  int count = 0;
+/// The fragment over which sample_surface averages NEAREST-filtered textures
+/// (raster/coverage/fragment_shading.hpp makes it): pixel (x, y) and the vertices of the
+/// triangle's part of it as perspective-correct weights (none when that part has no area).
+struct FragmentFootprint {
+  int x = 0;
+  int y = 0;
+  static constexpr int kMaxVertices = 7;  ///< a triangle clipped to a square
+  double vertex_mu[kMaxVertices][3];
+  int vertex_count = 0;
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -162,10 +165,11 @@ struct SurfaceSample {
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
 /// the level of detail from the exact screen-space derivatives of each UV set there;
 /// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
-/// With `taps` (count > 0), a NEAREST-filtered slot is the mean of its lookups at the taps'
-/// weights, each at the level of detail of mu0..mu2.
+/// With a `footprint`, a NEAREST-filtered slot is its average over the fragment at the level
+/// of detail of mu0..mu2 (core/texture_shading.cpp, footprint_average).
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                             const glm::dvec3& normal, const FootprintTaps* taps = nullptr);
+                             const glm::dvec3& normal,
+                             const FragmentFootprint* footprint = nullptr);
 
 /// The base colour texture's filtered alpha at the weights mu0..mu2 (1 without one): the
 /// texture term of surface_alpha, sampled exactly as sample_surface samples it.

@@ -266,6 +266,92 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
   return a * (1.0 - weight) + b * weight;
 }
 
+namespace {
+
+/// The cells of one level the overlap sum may visit: 8 x 8, a footprint of several texels
+/// (coverage mode asks on levels whose texels are about a pixel wide).
+constexpr long long kMaxCells = 64;
+
+/// nearest_area_average on one level.
+std::optional<glm::dvec4> level_area_average(const TextureLevel& level, const TexelDecoder& decode,
+                                             const TextureSampler& sampler,
+                                             const ConvexPolygon& uv) {
+  ConvexPolygon p = uv;
+  double x_min = HUGE_VAL, y_min = HUGE_VAL, x_max = -HUGE_VAL, y_max = -HUGE_VAL;
+  for (int i = 0; i < p.n; ++i) {
+    p.x[i] *= level.width;
+    p.y[i] *= level.height;
+    x_min = std::min(x_min, p.x[i]);
+    x_max = std::max(x_max, p.x[i]);
+    y_min = std::min(y_min, p.y[i]);
+    y_max = std::max(y_max, p.y[i]);
+  }
+  const long long x0 = texel_floor(x_min), x1 = texel_floor(x_max);
+  const long long y0 = texel_floor(y_min), y1 = texel_floor(y_max);
+  if (p.n < 3 || x1 - x0 >= kMaxCells || y1 - y0 >= kMaxCells ||
+      (x1 - x0 + 1) * (y1 - y0 + 1) > kMaxCells) {
+    return std::nullopt;
+  }
+  if (x0 == x1 && y0 == y1) {  // inside one texel: its value
+    if (!(polygon_area(p) > 1e-12)) return std::nullopt;
+    return decode(level.at(wrap_texel(x0, level.width, sampler.wrap_s),
+                           wrap_texel(y0, level.height, sampler.wrap_t)));
+  }
+  // Column strips first, then each strip's rows: two half-planes per strip and two per
+  // cell, and only the rows a strip reaches.
+  glm::dvec4 sum(0.0);
+  double area = 0.0;
+  for (long long tx = x0; tx <= x1; ++tx) {
+    const ConvexPolygon strip =
+        clip_half_plane(clip_half_plane(p, 1.0, 0.0, -double(tx)), -1.0, 0.0, double(tx + 1));
+    if (strip.n < 3) continue;
+    double strip_y_min = HUGE_VAL, strip_y_max = -HUGE_VAL;
+    for (int i = 0; i < strip.n; ++i) {
+      strip_y_min = std::min(strip_y_min, strip.y[i]);
+      strip_y_max = std::max(strip_y_max, strip.y[i]);
+    }
+    const long long r0 = std::max(y0, texel_floor(strip_y_min));
+    const long long r1 = std::min(y1, texel_floor(strip_y_max));
+    const int column = wrap_texel(tx, level.width, sampler.wrap_s);
+    for (long long ty = r0; ty <= r1; ++ty) {
+      const double part =
+          r0 == r1 ? polygon_area(strip)
+                   : polygon_area(clip_half_plane(clip_half_plane(strip, 0.0, 1.0, -double(ty)),
+                                                  0.0, -1.0, double(ty + 1)));
+      if (!(part > 0.0)) continue;
+      sum += decode(level.at(column, wrap_texel(ty, level.height, sampler.wrap_t))) * part;
+      area += part;
+    }
+  }
+  if (!(area > 1e-12)) return std::nullopt;
+  return sum / area;
+}
+
+}  // namespace
+
+std::optional<glm::dvec4> nearest_area_average(const Texture& texture,
+                                               const TextureSampler& sampler,
+                                               const ConvexPolygon& uv, double lod) {
+  if (texture.levels.empty()) return std::nullopt;
+  const TexelDecoder decode(texture.srgb);
+  const auto on = [&](int level) {
+    return level_area_average(texture.levels[std::size_t(level)], decode, sampler, uv);
+  };
+  // The levels exactly as sample_texture picks them.
+  const int last = int(texture.levels.size()) - 1;
+  if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) return on(0);
+  if (sampler.mip == MipFilter::Nearest) {
+    const double chosen = std::ceil(lod + 0.5) - 1.0;
+    return on(chosen >= last ? last : int(chosen));
+  }
+  if (lod >= last) return on(last);
+  const int d1 = int(std::floor(lod));
+  const double weight = lod - d1;
+  const std::optional<glm::dvec4> a = on(d1), b = on(d1 + 1);
+  if (!a || !b) return std::nullopt;
+  return *a * (1.0 - weight) + *b * weight;
+}
+
 glm::dvec2 transform_duv(const TextureTransform& t, const glm::dvec2& d) {
   const double x = d.x * t.scale.x, y = d.y * t.scale.y;
   if (t.rotation == 0.0) return glm::dvec2(x, y);  // the common case: no trigonometry

@@ -3,6 +3,7 @@
 // exact screen-space derivatives (below) for the level of detail, KHR_texture_transform,
 // and what each glTF slot does with its texel. Every mode reaches this through shade_lit,
 // so a point is textured alike in every mode, tile and thread.
+#include "core/shading.hpp"
 #include "core/shading_inputs.hpp"
 #include "core/texture_sampling.hpp"
 
@@ -42,11 +43,63 @@ WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double 
 
 namespace {
 
+/// The UV of a slot at weights mu (transformed).
+glm::dvec2 slot_uv(const TextureSlot& slot, const glm::vec2* uv, const double mu[3]) {
+  glm::dvec2 q(0.0);
+  for (int k = 0; k < 3; ++k) q += mu[k] * glm::dvec2(uv[k]);
+  return transform_uv(slot.transform, q);
+}
+
+/// The points of a 4x4 grid of pixel (x, y) ((i + 1/2) / 4, as ssaa:4 places its samples)
+/// that lie in `t`, edges included, as perspective-correct weights; returns their count.
+int grid_points_in(const TriangleSetup& t, int x, int y, double mu[16][3]) {
+  int count = 0;
+  for (int j = 0; j < 4; ++j) {
+    for (int i = 0; i < 4; ++i) {
+      double* m = mu[count];
+      // Unclamped weights are all >= 0 exactly where the point is in the triangle.
+      if (perspective_weights(t, x + (i + 0.5) / 4.0, y + (j + 0.5) / 4.0, false, m) &&
+          m[0] >= 0.0 && m[1] >= 0.0 && m[2] >= 0.0) {
+        ++count;
+      }
+    }
+  }
+  return count;
+}
+
+/// A NEAREST-filtered slot averaged over the fragment at level of detail `lod`: the exact
+/// overlap average over the triangle's part of the pixel (nearest_area_average); where that
+/// declines (a part over more than 64 texels of a level), the mean of the lookups at the
+/// grid points in the triangle; with none, the lookup at `centre` (the slot's UV there).
+glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, const glm::vec2* uv,
+                             const FragmentFootprint& footprint, const glm::dvec2& centre,
+                             double lod) {
+  if (footprint.vertex_count >= 3) {
+    ConvexPolygon polygon;
+    for (int i = 0; i < footprint.vertex_count; ++i) {
+      const glm::dvec2 q = slot_uv(slot, uv, footprint.vertex_mu[i]);
+      polygon.add(q.x, q.y);
+    }
+    if (const auto mean = nearest_area_average(*slot.texture, slot.sampler, polygon, lod)) {
+      return *mean;
+    }
+  }
+  double mu[16][3];
+  const int count = grid_points_in(t, footprint.x, footprint.y, mu);
+  if (count == 0) return sample_texture(*slot.texture, slot.sampler, centre, lod);
+  glm::dvec4 sum(0.0);
+  for (int i = 0; i < count; ++i) {
+    sum += sample_texture(*slot.texture, slot.sampler, slot_uv(slot, uv, mu[i]), lod);
+  }
+  return sum / double(count);
+}
+
 /// One slot's filtered texel: its UV set at the point, transformed, with the level of detail
-/// of the transformed derivatives. A NEAREST-filtered slot with `taps`: the mean of the
-/// lookups at the taps' weights, at that level of detail.
-glm::dvec4 lookup(const TextureSlot& slot, const TexturedCorners& corners, const double mu[3],
-                  const WeightDerivatives& d, const FootprintTaps* taps) {
+/// of the transformed derivatives. A NEAREST-filtered slot with a `footprint`: its average
+/// over the fragment at that level of detail (footprint_average).
+glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const TexturedCorners& corners,
+                  const double mu[3], const WeightDerivatives& d,
+                  const FragmentFootprint* footprint) {
   // check_scene refuses other sets; a scene built without it must still not read out of bounds.
   const glm::vec2* uv = corners.uv[slot.texcoord == 1 ? 1 : 0];
   glm::dvec2 p(0.0), dx(0.0), dy(0.0);
@@ -59,16 +112,11 @@ glm::dvec4 lookup(const TextureSlot& slot, const TexturedCorners& corners, const
   dy = transform_duv(slot.transform, dy);
   const double lod = texture_lod(*slot.texture, dx, dy);
   const TextureFilter filter = lod > 0.0 ? slot.sampler.min : slot.sampler.mag;
-  if (taps == nullptr || taps->count == 0 || filter != TextureFilter::Nearest) {
-    return sample_texture(*slot.texture, slot.sampler, transform_uv(slot.transform, p), lod);
+  p = transform_uv(slot.transform, p);
+  if (footprint == nullptr || filter != TextureFilter::Nearest) {
+    return sample_texture(*slot.texture, slot.sampler, p, lod);
   }
-  glm::dvec4 sum(0.0);
-  for (int i = 0; i < taps->count; ++i) {
-    glm::dvec2 q(0.0);
-    for (int k = 0; k < 3; ++k) q += taps->mu[i][k] * glm::dvec2(uv[k]);
-    sum += sample_texture(*slot.texture, slot.sampler, transform_uv(slot.transform, q), lod);
-  }
-  return sum / double(taps->count);
+  return footprint_average(t, slot, uv, *footprint, p, lod);
 }
 
 /// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
@@ -95,36 +143,37 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
 /// KHR_materials_sheen (colour in RGB, roughness in A) and KHR_materials_clearcoat (weight in R,
 /// roughness in G, its own normal map, which perturbs the interpolated normal, not the base's
 /// mapped one); each multiplies the surface's factor.
-void sample_material_extensions(const SurfaceShading& s, const SurfaceTextures& slots,
-                                const TexturedCorners& corners, const double mu[3],
-                                const WeightDerivatives& d, const FootprintTaps* taps,
-                                SurfaceSample& out) {
+void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
+                                const SurfaceTextures& slots, const TexturedCorners& corners,
+                                const double mu[3], const WeightDerivatives& d,
+                                const FragmentFootprint* footprint, SurfaceSample& out) {
   if (slots.specular != nullptr)
-    out.specular_weight *= lookup(*slots.specular, corners, mu, d, taps).a;
+    out.specular_weight *= lookup(t, *slots.specular, corners, mu, d, footprint).a;
   if (slots.specular_color != nullptr) {
-    out.specular_color *= glm::dvec3(lookup(*slots.specular_color, corners, mu, d, taps));
+    out.specular_color *= glm::dvec3(lookup(t, *slots.specular_color, corners, mu, d, footprint));
   }
-  if (slots.clearcoat != nullptr) out.clearcoat *= lookup(*slots.clearcoat, corners, mu, d, taps).r;
+  if (slots.clearcoat != nullptr)
+    out.clearcoat *= lookup(t, *slots.clearcoat, corners, mu, d, footprint).r;
   if (slots.clearcoat_roughness != nullptr) {
-    out.clearcoat_roughness *= lookup(*slots.clearcoat_roughness, corners, mu, d, taps).g;
+    out.clearcoat_roughness *= lookup(t, *slots.clearcoat_roughness, corners, mu, d, footprint).g;
   }
   if (slots.iridescence != nullptr)
-    out.iridescence *= lookup(*slots.iridescence, corners, mu, d, taps).r;
+    out.iridescence *= lookup(t, *slots.iridescence, corners, mu, d, footprint).r;
   if (slots.iridescence_thickness != nullptr) {
-    const double g = lookup(*slots.iridescence_thickness, corners, mu, d, taps).g;
+    const double g = lookup(t, *slots.iridescence_thickness, corners, mu, d, footprint).g;
     out.iridescence_thickness_nm =
         s.iridescence_thickness_min_nm +
         (s.iridescence_thickness_nm - s.iridescence_thickness_min_nm) * g;
   }
   if (slots.sheen_color != nullptr) {
-    out.sheen_color *= glm::dvec3(lookup(*slots.sheen_color, corners, mu, d, taps));
+    out.sheen_color *= glm::dvec3(lookup(t, *slots.sheen_color, corners, mu, d, footprint));
   }
   if (slots.sheen_roughness != nullptr) {
-    out.sheen_roughness *= lookup(*slots.sheen_roughness, corners, mu, d, taps).a;
+    out.sheen_roughness *= lookup(t, *slots.sheen_roughness, corners, mu, d, footprint).a;
   }
   if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
     out.clearcoat_normal =
-        perturbed_normal(lookup(*slots.clearcoat_normal, corners, mu, d, taps),
+        perturbed_normal(lookup(t, *slots.clearcoat_normal, corners, mu, d, footprint),
                          slots.clearcoat_normal->scale, corners, mu, out.clearcoat_normal);
   }
 }
@@ -135,13 +184,13 @@ double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, 
   const ShadingRecord& r = *t.shading;
   if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return 1.0;
   const double mu[3] = {mu0, mu1, mu2};
-  return lookup(*r.surface->textures->base_color, *r.textured, mu,
+  return lookup(t, *r.surface->textures->base_color, *r.textured, mu,
                 weight_derivatives(t, mu0, mu1, mu2), nullptr)
       .a;
 }
 
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                             const glm::dvec3& normal, const FootprintTaps* taps) {
+                             const glm::dvec3& normal, const FragmentFootprint* footprint) {
   const ShadingRecord& r = *t.shading;
   const SurfaceShading& s = *r.surface;
   const SurfaceTextures& slots = *s.textures;
@@ -162,24 +211,25 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.iridescence_thickness_nm = s.iridescence_thickness_nm;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
-  if (slots.base_color != nullptr) out.base_color = lookup(*slots.base_color, corners, mu, d, taps);
+  if (slots.base_color != nullptr)
+    out.base_color = lookup(t, *slots.base_color, corners, mu, d, footprint);
   if (slots.metallic_roughness != nullptr) {
-    const glm::dvec4 v = lookup(*slots.metallic_roughness, corners, mu, d, taps);
+    const glm::dvec4 v = lookup(t, *slots.metallic_roughness, corners, mu, d, footprint);
     out.roughness *= v.g;
     out.metallic *= v.b;
   }
   if (slots.occlusion != nullptr) {
-    const glm::dvec4 v = lookup(*slots.occlusion, corners, mu, d, taps);
+    const glm::dvec4 v = lookup(t, *slots.occlusion, corners, mu, d, footprint);
     out.occlusion = 1.0 + double(slots.occlusion->scale) * (v.r - 1.0);
   }
   if (slots.emissive != nullptr) {
-    out.emissive *= glm::dvec3(lookup(*slots.emissive, corners, mu, d, taps));
+    out.emissive *= glm::dvec3(lookup(t, *slots.emissive, corners, mu, d, footprint));
   }
   if (slots.normal != nullptr && normal != glm::dvec3(0.0)) {
-    out.normal = perturbed_normal(lookup(*slots.normal, corners, mu, d, taps), slots.normal->scale,
-                                  corners, mu, normal);
+    out.normal = perturbed_normal(lookup(t, *slots.normal, corners, mu, d, footprint),
+                                  slots.normal->scale, corners, mu, normal);
   }
-  sample_material_extensions(s, slots, corners, mu, d, taps, out);
+  sample_material_extensions(t, s, slots, corners, mu, d, footprint, out);
   return out;
 }
 

@@ -17,12 +17,14 @@
 namespace covrast::detail {
 
 /// The shading of a fragment whose surface has a NEAREST-filtered texture: the clamped
-/// centre's weights for everything else, and for those textures the mean of their lookups at
-/// the points of a 4x4 grid of the pixel ((i + 1/2) / 4, i = 0..3, as ssaa:4 places its
-/// samples) that lie in the triangle, each at the centre's level of detail (ssaa's and the
-/// reference's samples use the level of the pixel's footprint too). With no grid point in
-/// the triangle (a sliver between them) the centre's lookup alone. Out of line: it is the
-/// slow path.
+/// centre's weights for everything else, and for those textures their exact average over the
+/// triangle's part of the pixel at the centre's level of detail (the texels weighted by
+/// their overlap areas with that part mapped into the texture, core/texture_sampling.hpp
+/// nearest_area_average; the reference's and ssaa's samples use the level of the pixel's
+/// footprint too). Where that declines (a part over more than 64 texels of a level), the
+/// mean of the lookups at the points of a 4x4 grid of the pixel ((i + 1/2) / 4, as ssaa:4
+/// places its samples) that lie in the triangle; with none of them in it, the centre's
+/// lookup. Out of line: it is the slow path.
 glm::vec3 shade_fragment_averaged(const TriangleSetup& t, int x, int y);
 
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
