@@ -1222,6 +1222,24 @@ covrast::Scene nearest_quad_scene(int size, int texels, const std::vector<std::u
                                   covrast::MipFilter::None));
 }
 
+/// The largest |image - expected(px, py, c)| in 8-bit codes over the size x size pixels where
+/// keep(px, py).
+template <class Expected, class Keep>
+int largest_difference(const covrast::Image& image, int size, const Expected& expected,
+                       const Keep& keep) {
+  int largest = 0;
+  for (int py = 0; py < size; ++py) {
+    for (int px = 0; px < size; ++px) {
+      if (!keep(px, py)) continue;
+      for (int c = 0; c < 3; ++c) {
+        const int code = image.rgb[(std::size_t(py) * size + px) * 3 + c];
+        largest = std::max(largest, std::abs(code - expected(px, py, c)));
+      }
+    }
+  }
+  return largest;
+}
+
 }  // namespace
 
 TEST_CASE("textures: coverage mode's NEAREST texture is the exact mean over the pixel",
@@ -1234,20 +1252,14 @@ TEST_CASE("textures: coverage mode's NEAREST texture is the exact mean over the 
   const int size = 48, texels = 64;
   const auto rgba = random_rgba(texels, texels, 11);
   const covrast::Scene scene = nearest_quad_scene(size, texels, rgba);
-  const covrast::Image coverage = render_mode(scene, "coverage");
-  const covrast::Image aliased = render_mode(scene, "aliased");
-  int largest_coverage = 0, largest_aliased = 0;
-  for (int py = 0; py < size; ++py) {
-    for (int px = 0; px < size; ++px) {
-      for (int c = 0; c < 3; ++c) {
-        const int exact =
-            int(std::lround(srgb_encode_255(exact_pixel_mean(rgba, texels, size, px, py, c))));
-        const std::size_t i = (std::size_t(py) * size + px) * 3 + c;
-        largest_coverage = std::max(largest_coverage, std::abs(int(coverage.rgb[i]) - exact));
-        largest_aliased = std::max(largest_aliased, std::abs(int(aliased.rgb[i]) - exact));
-      }
-    }
-  }
+  const auto exact = [&](int px, int py, int c) {
+    return int(std::lround(srgb_encode_255(exact_pixel_mean(rgba, texels, size, px, py, c))));
+  };
+  const auto every_pixel = [](int, int) { return true; };
+  const int largest_coverage =
+      largest_difference(render_mode(scene, "coverage"), size, exact, every_pixel);
+  const int largest_aliased =
+      largest_difference(render_mode(scene, "aliased"), size, exact, every_pixel);
   INFO("largest difference from the exact mean: coverage " << largest_coverage << ", aliased "
                                                            << largest_aliased);
   CHECK(largest_coverage <= 1);
@@ -1263,24 +1275,13 @@ TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa
   const int size = 48, texels = 512;
   const auto rgba = random_rgba(texels, texels, 5);
   const covrast::Scene scene = nearest_quad_scene(size, texels, rgba);
-  const covrast::Image coverage = render_mode(scene, "coverage");
   const covrast::Image ssaa = render_mode(scene, "ssaa:4");
-  const covrast::Image aliased = render_mode(scene, "aliased");
-  int largest_vs_ssaa = 0, largest_aliased_vs_ssaa = 0;
-  for (int py = 0; py < size; ++py) {
-    for (int px = 0; px < size; ++px) {
-      if (std::abs(px + py - (size - 1)) <= 1) continue;  // the diagonal
-      for (int c = 0; c < 3; ++c) {
-        const std::size_t i = (std::size_t(py) * size + px) * 3 + c;
-        largest_vs_ssaa =
-            std::max(largest_vs_ssaa, std::abs(int(coverage.rgb[i]) - int(ssaa.rgb[i])));
-        largest_aliased_vs_ssaa =
-            std::max(largest_aliased_vs_ssaa, std::abs(int(aliased.rgb[i]) - int(ssaa.rgb[i])));
-      }
-    }
-  }
-  CHECK(largest_vs_ssaa <= 1);
-  CHECK(largest_aliased_vs_ssaa > 50);
+  const auto ssaa_code = [&](int px, int py, int c) {
+    return int(ssaa.rgb[(std::size_t(py) * size + px) * 3 + c]);
+  };
+  const auto off_diagonal = [&](int px, int py) { return std::abs(px + py - (size - 1)) > 1; };
+  CHECK(largest_difference(render_mode(scene, "coverage"), size, ssaa_code, off_diagonal) <= 1);
+  CHECK(largest_difference(render_mode(scene, "aliased"), size, ssaa_code, off_diagonal) > 50);
 }
 
 TEST_CASE("textures: nearest_area_average weighs texels by their overlap areas", "[textures]") {
