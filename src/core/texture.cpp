@@ -240,30 +240,45 @@ glm::dvec4 sample_level(const TextureLevel& level, const TexelDecoder& decode,
 
 }  // namespace
 
+namespace {
+
+/// The levels a lookup at `lod` reads, their filter and blend (OpenGL 4.6, 8.14.3): `first`
+/// alone when `second` is -1, else first x (1 - weight) + second x weight.
+struct LevelChoice {
+  int first = 0;
+  int second = -1;
+  double weight = 0.0;
+  TextureFilter filter = TextureFilter::Linear;
+};
+
+LevelChoice choose_levels(const Texture& texture, const TextureSampler& sampler, double lod) {
+  const int last = int(texture.levels.size()) - 1;
+  if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) {
+    return {0, -1, 0.0, lod > 0.0 ? sampler.min : sampler.mag};
+  }
+  if (sampler.mip == MipFilter::Nearest) {
+    // Level ceil(lod + 1/2) - 1, clamped to the chain.
+    const double chosen = std::ceil(lod + 0.5) - 1.0;
+    return {chosen >= last ? last : int(chosen), -1, 0.0, sampler.min};
+  }
+  if (lod >= last) return {last, -1, 0.0, sampler.min};
+  const int d1 = int(std::floor(lod));
+  return {d1, d1 + 1, lod - d1, sampler.min};
+}
+
+}  // namespace
+
 glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
                           const glm::dvec2& uv, double lod) {
   if (texture.levels.empty()) return glm::dvec4(1.0);  // refused by check_scene; no crash
   const TexelDecoder decode(texture.srgb);
-  const int last = int(texture.levels.size()) - 1;
-  if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) {
-    const TextureFilter filter = lod > 0.0 ? sampler.min : sampler.mag;
-    return sample_level(texture.levels[0], decode, sampler, uv, filter);
-  }
-  if (sampler.mip == MipFilter::Nearest) {
-    // OpenGL 4.6, 8.14.3: level ceil(lod + 1/2) - 1, clamped to the chain.
-    const double chosen = std::ceil(lod + 0.5) - 1.0;
-    const int level = chosen >= last ? last : int(chosen);
-    return sample_level(texture.levels[std::size_t(level)], decode, sampler, uv, sampler.min);
-  }
-  if (lod >= last)
-    return sample_level(texture.levels[std::size_t(last)], decode, sampler, uv, sampler.min);
-  const int d1 = int(std::floor(lod));
-  const double weight = lod - d1;
+  const LevelChoice c = choose_levels(texture, sampler, lod);
   const glm::dvec4 a =
-      sample_level(texture.levels[std::size_t(d1)], decode, sampler, uv, sampler.min);
+      sample_level(texture.levels[std::size_t(c.first)], decode, sampler, uv, c.filter);
+  if (c.second < 0) return a;
   const glm::dvec4 b =
-      sample_level(texture.levels[std::size_t(d1 + 1)], decode, sampler, uv, sampler.min);
-  return a * (1.0 - weight) + b * weight;
+      sample_level(texture.levels[std::size_t(c.second)], decode, sampler, uv, c.filter);
+  return a * (1.0 - c.weight) + b * c.weight;
 }
 
 namespace {
@@ -334,22 +349,14 @@ std::optional<glm::dvec4> nearest_area_average(const Texture& texture,
                                                const ConvexPolygon& uv, double lod) {
   if (texture.levels.empty()) return std::nullopt;
   const TexelDecoder decode(texture.srgb);
-  const auto on = [&](int level) {
-    return level_area_average(texture.levels[std::size_t(level)], decode, sampler, uv);
-  };
-  // The levels exactly as sample_texture picks them.
-  const int last = int(texture.levels.size()) - 1;
-  if (!(lod > 0.0) || sampler.mip == MipFilter::None || last == 0) return on(0);
-  if (sampler.mip == MipFilter::Nearest) {
-    const double chosen = std::ceil(lod + 0.5) - 1.0;
-    return on(chosen >= last ? last : int(chosen));
-  }
-  if (lod >= last) return on(last);
-  const int d1 = int(std::floor(lod));
-  const double weight = lod - d1;
-  const std::optional<glm::dvec4> a = on(d1), b = on(d1 + 1);
-  if (!a || !b) return std::nullopt;
-  return *a * (1.0 - weight) + *b * weight;
+  const LevelChoice c = choose_levels(texture, sampler, lod);  // as sample_texture reads them
+  const std::optional<glm::dvec4> a =
+      level_area_average(texture.levels[std::size_t(c.first)], decode, sampler, uv);
+  if (c.second < 0 || !a) return a;
+  const std::optional<glm::dvec4> b =
+      level_area_average(texture.levels[std::size_t(c.second)], decode, sampler, uv);
+  if (!b) return std::nullopt;
+  return *a * (1.0 - c.weight) + *b * c.weight;
 }
 
 glm::dvec2 transform_duv(const TextureTransform& t, const glm::dvec2& d) {

@@ -4,6 +4,7 @@
 // UVs and tangents, vertex alphas), and its ShadingRecord.
 #include "geometry/frontend.hpp"
 
+#include <array>
 #include <cmath>
 
 namespace covrast::detail {
@@ -62,23 +63,27 @@ SurfaceTextures surface_slots(const Material& m, bool lit) {
   return out;
 }
 
+/// Every slot of `t`, null where the material has none.
+std::array<const TextureSlot*, 14> all_slots(const SurfaceTextures& t) {
+  return {t.base_color,
+          t.metallic_roughness,
+          t.normal,
+          t.occlusion,
+          t.emissive,
+          t.specular,
+          t.specular_color,
+          t.clearcoat,
+          t.clearcoat_roughness,
+          t.clearcoat_normal,
+          t.sheen_color,
+          t.sheen_roughness,
+          t.iridescence,
+          t.iridescence_thickness};
+}
+
 /// Whether some slot of `t` filters NEAREST within a mip level.
 bool any_nearest_filtered(const SurfaceTextures& t) {
-  const TextureSlot* const slots[] = {t.base_color,
-                                      t.metallic_roughness,
-                                      t.normal,
-                                      t.occlusion,
-                                      t.emissive,
-                                      t.specular,
-                                      t.specular_color,
-                                      t.clearcoat,
-                                      t.clearcoat_roughness,
-                                      t.clearcoat_normal,
-                                      t.sheen_color,
-                                      t.sheen_roughness,
-                                      t.iridescence,
-                                      t.iridescence_thickness};
-  for (const TextureSlot* slot : slots) {
+  for (const TextureSlot* slot : all_slots(t)) {
     if (slot != nullptr && (slot->sampler.min == TextureFilter::Nearest ||
                             slot->sampler.mag == TextureFilter::Nearest)) {
       return true;
@@ -95,12 +100,10 @@ SurfaceTextures surface_textures(const Material& m, bool lit) {
 }
 
 bool any_texture(const SurfaceTextures& t) {
-  return t.base_color != nullptr || t.metallic_roughness != nullptr || t.normal != nullptr ||
-         t.occlusion != nullptr || t.emissive != nullptr || t.specular != nullptr ||
-         t.specular_color != nullptr || t.clearcoat != nullptr ||
-         t.clearcoat_roughness != nullptr || t.clearcoat_normal != nullptr ||
-         t.sheen_color != nullptr || t.sheen_roughness != nullptr || t.iridescence != nullptr ||
-         t.iridescence_thickness != nullptr;
+  for (const TextureSlot* slot : all_slots(t)) {
+    if (slot != nullptr) return true;
+  }
+  return false;
 }
 
 }  // namespace
