@@ -129,7 +129,9 @@ TEST_CASE("textures: mip level 1 is the 2x2 mean in linear light (LINEAR_MIPMAP_
   const covrast::Scene scene =
       quad_scene(32, slot_of(texture, covrast::TextureFilter::Linear,
                              covrast::TextureFilter::Linear, covrast::MipFilter::Linear));
-  const covrast::Image image = render_mode(scene, "coverage");
+  // Aliased mode looks up at each pixel's centre, which is level 1's texel centre (lod 1
+  // exactly); coverage mode averages the bilinear filter over the pixel, which blurs it.
+  const covrast::Image image = render_mode(scene, "aliased");
   double worst = 0.0;
   for (int y = 0; y < 32; ++y) {
     for (int x = 0; x < 32; ++x) {
@@ -1215,6 +1217,34 @@ double exact_pixel_mean(const std::vector<std::uint8_t>& rgba, int texels, int s
   return mean / (t * t);
 }
 
+/// The exact box average of a LINEAR level-0 texture of `texels`^2 (REPEAT) on
+/// quad_scene(size): the bilinear filter is the sum of texels times tents,
+/// T_ij tent(s - i) tent(t - j) with s = u texels - 1/2, so over the pixel's box (separable)
+/// its mean is sum_ij T_ij X_i Y_j with X_i the mean of tent(s - i) over the pixel's s range.
+double exact_bilinear_pixel_mean(const std::vector<std::uint8_t>& rgba, int texels, int size,
+                                 int px, int py, int c) {
+  const double t = double(texels) / size;
+  // The integral of the tent max(0, 1 - |x|) from -infinity to x.
+  const auto tent_integral = [](double x) {
+    if (x <= -1.0) return 0.0;
+    if (x <= 0.0) return (1.0 + x) * (1.0 + x) / 2.0;
+    if (x <= 1.0) return 1.0 - (1.0 - x) * (1.0 - x) / 2.0;
+    return 1.0;
+  };
+  const auto weight = [&](int pixel, int texel) {
+    const double lo = pixel * t - 0.5, hi = (pixel + 1) * t - 0.5;
+    return (tent_integral(hi - texel) - tent_integral(lo - texel)) / t;
+  };
+  double mean = 0.0;
+  for (int ty = int(std::floor(py * t - 0.5)); ty <= int(std::ceil((py + 1) * t - 0.5)); ++ty) {
+    for (int tx = int(std::floor(px * t - 0.5)); tx <= int(std::ceil((px + 1) * t - 0.5)); ++tx) {
+      const int i = (tx + texels) % texels, j = (ty + texels) % texels;
+      mean += weight(px, tx) * weight(py, ty) * srgb_decode(rgba[(j * texels + i) * 4 + c]);
+    }
+  }
+  return mean;
+}
+
 /// quad_scene(size) textured with `rgba` (texels x texels, sRGB), NEAREST on level 0 only.
 covrast::Scene nearest_quad_scene(int size, int texels, const std::vector<std::uint8_t>& rgba) {
   return quad_scene(size, slot_of(covrast::make_texture("noise", texels, texels, rgba, true),
@@ -1266,6 +1296,33 @@ TEST_CASE("textures: coverage mode's NEAREST texture is the exact mean over the 
   CHECK(largest_aliased > 50);  // the scene does test something
 }
 
+TEST_CASE("textures: coverage mode's LINEAR texture is the exact mean over the pixel",
+          "[textures]") {
+  // 64x64 random texels LINEAR, level 0 only, on 48x48 pixels: the bilinear filter has kinks
+  // at texel centres 3/4 of a pixel apart, so its value at the pixel centre (aliased, msaa)
+  // is not the pixel's mean. Coverage mode integrates the filter over each triangle's part
+  // of the pixel (core/texture_sampling.hpp, area_average): the exact mean, diagonal too.
+  const int size = 48, texels = 64;
+  const auto rgba = random_rgba(texels, texels, 17);
+  const covrast::Scene scene =
+      quad_scene(size, slot_of(covrast::make_texture("noise", texels, texels, rgba, true),
+                               covrast::TextureFilter::Linear, covrast::TextureFilter::Linear,
+                               covrast::MipFilter::None));
+  const auto exact = [&](int px, int py, int c) {
+    return int(
+        std::lround(srgb_encode_255(exact_bilinear_pixel_mean(rgba, texels, size, px, py, c))));
+  };
+  const auto every_pixel = [](int, int) { return true; };
+  const int largest_coverage =
+      largest_difference(render_mode(scene, "coverage"), size, exact, every_pixel);
+  const int largest_aliased =
+      largest_difference(render_mode(scene, "aliased"), size, exact, every_pixel);
+  INFO("largest difference from the exact mean: coverage " << largest_coverage << ", aliased "
+                                                           << largest_aliased);
+  CHECK(largest_coverage <= 1);
+  CHECK(largest_aliased > 40);  // the scene does test something
+}
+
 TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa:4's points",
           "[textures]") {
   // 512x512 texels on 48x48 pixels, level 0 only: a pixel spans about 11 x 11 texels, more
@@ -1284,7 +1341,7 @@ TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa
   CHECK(largest_difference(render_mode(scene, "aliased"), size, ssaa_code, off_diagonal) > 50);
 }
 
-TEST_CASE("textures: nearest_area_average weighs texels by their overlap areas", "[textures]") {
+TEST_CASE("textures: area_average weighs NEAREST texels by their overlap areas", "[textures]") {
   // 4x4 texels, texel (i, j) grey (16 i + 64 j) / 255 in a linear texture.
   std::vector<std::uint8_t> rgba(4 * 4 * 4, 255);
   for (int j = 0; j < 4; ++j) {
@@ -1302,7 +1359,7 @@ TEST_CASE("textures: nearest_area_average weighs texels by their overlap areas",
     return p;
   };
   const auto grey = [&](const covrast::detail::ConvexPolygon& p) {
-    const auto mean = covrast::detail::nearest_area_average(*texture, sampler, p, -1.0);
+    const auto mean = covrast::detail::area_average(*texture, sampler, p, -1.0);
     REQUIRE(mean.has_value());
     return mean->r * 255.0;
   };
@@ -1320,11 +1377,65 @@ TEST_CASE("textures: nearest_area_average weighs texels by their overlap areas",
   // A footprint over more than 64 texel cells: declined.
   sampler.wrap_s = sampler.wrap_t = covrast::TextureWrap::Repeat;
   CHECK_FALSE(
-      covrast::detail::nearest_area_average(
-          *texture, sampler, polygon({{0.0, 0.0}, {9.0, 0.0}, {9.0, 9.0}, {0.0, 9.0}}), -1.0)
+      covrast::detail::area_average(*texture, sampler,
+                                    polygon({{0.0, 0.0}, {9.0, 0.0}, {9.0, 9.0}, {0.0, 9.0}}), -1.0)
           .has_value());
   // No area: declined.
-  CHECK_FALSE(covrast::detail::nearest_area_average(
-                  *texture, sampler, polygon({{0.0, 0.0}, {1.0, 1.0}, {2.0, 2.0}}), -1.0)
+  CHECK_FALSE(covrast::detail::area_average(*texture, sampler,
+                                            polygon({{0.0, 0.0}, {1.0, 1.0}, {2.0, 2.0}}), -1.0)
                   .has_value());
+}
+
+TEST_CASE("textures: area_average integrates the LINEAR filter exactly", "[textures]") {
+  covrast::TextureSampler sampler;
+  sampler.mag = sampler.min = covrast::TextureFilter::Linear;
+  sampler.mip = covrast::MipFilter::None;
+  // Polygons given in s, t = texel coordinates - 1/2 (texel centres at integers).
+  const auto polygon = [](std::initializer_list<glm::dvec2> points) {
+    covrast::detail::ConvexPolygon p;
+    for (const glm::dvec2& q : points) p.add((q.x + 0.5) / 4.0, (q.y + 0.5) / 4.0);
+    return p;
+  };
+  const auto mean_of = [&](const std::shared_ptr<const covrast::Texture>& texture,
+                           const covrast::detail::ConvexPolygon& p) {
+    const auto mean = covrast::detail::area_average(*texture, sampler, p, -1.0);
+    REQUIRE(mean.has_value());
+    return mean->r;
+  };
+  SECTION("a linear ramp: the filter is linear between the centres, its mean the centroid's") {
+    // Texel (i, j) grey (16 i + 64 j) / 255 in a linear texture; f = (16 s + 64 t) / 255 on
+    // [0, 3]^2.
+    std::vector<std::uint8_t> rgba(4 * 4 * 4, 255);
+    for (int j = 0; j < 4; ++j) {
+      for (int i = 0; i < 4; ++i) {
+        for (int c = 0; c < 3; ++c) rgba[(j * 4 + i) * 4 + c] = std::uint8_t(16 * i + 64 * j);
+      }
+    }
+    const auto ramp = covrast::make_texture("ramp", 4, 4, rgba, false);
+    // A triangle over six cells, centroid (1.5, 1.2): 16 x 1.5 + 64 x 1.2 = 100.8.
+    CHECK(mean_of(ramp, polygon({{0.2, 0.3}, {2.9, 0.6}, {1.4, 2.7}})) * 255.0 ==
+          Approx(100.8).margin(1e-9));
+    // A square inside one cell, centred on (0.5, 2.5): 8 + 160 = 168.
+    CHECK(mean_of(ramp, polygon({{0.25, 2.25}, {0.75, 2.25}, {0.75, 2.75}, {0.25, 2.75}})) *
+              255.0 ==
+          Approx(168.0).margin(1e-9));
+  }
+  SECTION("one white texel: its tent tent(s - 1) tent(t - 1) integrated") {
+    std::vector<std::uint8_t> rgba(4 * 4 * 4, 0);
+    for (int c = 0; c < 4; ++c) rgba[(1 * 4 + 1) * 4 + c] = 255;
+    const auto spot = covrast::make_texture("spot", 4, 4, rgba, false);
+    // [0, 2]^2 holds the whole tent (integral 1) in area 4.
+    CHECK(mean_of(spot, polygon({{0, 0}, {2, 0}, {2, 2}, {0, 2}})) == Approx(0.25).margin(1e-12));
+    // [1, 2]^2: (1/2)(1/2) in area 1.
+    CHECK(mean_of(spot, polygon({{1, 1}, {2, 1}, {2, 2}, {1, 2}})) == Approx(0.25).margin(1e-12));
+    // The triangle (1, 1), (2, 1), (1, 2): the integral of (1 - a)(1 - b) over a + b <= 1 is
+    // 1/3 - 1/8 = 5/24, in area 1/2.
+    CHECK(mean_of(spot, polygon({{1, 1}, {2, 1}, {1, 2}})) == Approx(5.0 / 12.0).margin(1e-12));
+    // The same triangle clockwise: the orientation cancels.
+    CHECK(mean_of(spot, polygon({{1, 1}, {1, 2}, {2, 1}})) == Approx(5.0 / 12.0).margin(1e-12));
+    // Across the REPEAT seam: [-1, 0] x [0, 1] sees texel (3, .) and (0, .), not the spot.
+    CHECK(mean_of(spot, polygon({{-1, 0}, {0, 0}, {0, 1}, {-1, 1}})) == Approx(0.0).margin(1e-12));
+    // Shifted by the period, the spot's square [1, 2]^2 again.
+    CHECK(mean_of(spot, polygon({{5, 5}, {6, 5}, {6, 6}, {5, 6}})) == Approx(0.25).margin(1e-12));
+  }
 }

@@ -14,7 +14,7 @@ struct FragmentFootprint;
 /// The lit colour of `t` at the perspective-correct barycentric weights mu0..mu2 (summing
 /// to 1): base colour, position and normal interpolated with them (the normal renormalised),
 /// then the material's lighting (core/shading.cpp). Out of line: it is the slow path.
-/// `footprint`: where NEAREST-filtered textures are averaged (sample_surface,
+/// `footprint`: where the textures are averaged (sample_surface,
 /// core/shading_inputs.hpp).
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
                     const FragmentFootprint* footprint = nullptr);

@@ -68,12 +68,9 @@ struct SurfaceTextures {
   const TextureSlot* sheen_roughness = nullptr;        ///< KHR_materials_sheen, A
   const TextureSlot* iridescence = nullptr;            ///< KHR_materials_iridescence, R
   const TextureSlot* iridescence_thickness = nullptr;  ///< KHR_materials_iridescence, G
-  /// Some slot filters NEAREST within a mip level (magnification or minification): coverage
-  /// mode averages such slots over the fragment (raster/coverage/fragment_shading.hpp).
-  bool nearest_filtered = false;
 };
 
-/// The fragment over which sample_surface averages NEAREST-filtered textures
+/// The fragment over which sample_surface averages its textures
 /// (raster/coverage/fragment_shading.hpp makes it): pixel (x, y) and the vertices of the
 /// triangle's part of it as perspective-correct weights (none when that part has no area).
 struct FragmentFootprint {
@@ -165,7 +162,7 @@ struct SurfaceSample {
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
 /// the level of detail from the exact screen-space derivatives of each UV set there;
 /// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
-/// With a `footprint`, a NEAREST-filtered slot is its average over the fragment at the level
+/// With a `footprint`, each slot is its average over the fragment at the level
 /// of detail of mu0..mu2 (core/texture_shading.cpp, footprint_average).
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
                              const glm::dvec3& normal,

@@ -283,78 +283,164 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
 
 namespace {
 
-/// The cells of one level the overlap sum may visit: 8 x 8, a footprint of several texels
+/// The cells of one level an average may reach: 8 x 8, a footprint of several texels
 /// (coverage mode asks on levels whose texels are about a pixel wide).
 constexpr long long kMaxCells = 64;
+/// The texels those cells read: (64 + 1) x (1 + 1) at most, for the bilinear filter.
+constexpr int kMaxTexels = 130;
 
-/// nearest_area_average on one level.
-std::optional<glm::dvec4> level_area_average(const TextureLevel& level, const TexelDecoder& decode,
-                                             const TextureSampler& sampler,
-                                             const ConvexPolygon& uv) {
-  ConvexPolygon p = uv;
-  double x_min = HUGE_VAL, y_min = HUGE_VAL, x_max = -HUGE_VAL, y_max = -HUGE_VAL;
-  for (int i = 0; i < p.n; ++i) {
-    p.x[i] *= level.width;
-    p.y[i] *= level.height;
-    x_min = std::min(x_min, p.x[i]);
-    x_max = std::max(x_max, p.x[i]);
-    y_min = std::min(y_min, p.y[i]);
-    y_max = std::max(y_max, p.y[i]);
+/// The integrals over `q` of 1, a, b and a b, with a = s - s0, b = t - t0, signed by its
+/// orientation (Green's theorem; Steger, "On the calculation of arbitrary moments of
+/// polygons", 1996): with c_i = a_i b_j - a_j b_i, j = i + 1,
+///   M_1 = sum c_i / 2,  M_a = sum (a_i + a_j) c_i / 6,  M_b = sum (b_i + b_j) c_i / 6,
+///   M_ab = sum (2 a_i b_i + a_i b_j + a_j b_i + 2 a_j b_j) c_i / 24.
+struct Moments {
+  double m1 = 0.0, ma = 0.0, mb = 0.0, mab = 0.0;
+};
+
+Moments moments(const ConvexPolygon& q, double s0, double t0) {
+  Moments m;
+  for (int i = 0; i < q.n; ++i) {
+    const int j = i + 1 == q.n ? 0 : i + 1;
+    const double ai = q.x[i] - s0, bi = q.y[i] - t0, aj = q.x[j] - s0, bj = q.y[j] - t0;
+    const double c = ai * bj - aj * bi;
+    m.m1 += c;
+    m.ma += (ai + aj) * c;
+    m.mb += (bi + bj) * c;
+    m.mab += (2.0 * ai * bi + ai * bj + aj * bi + 2.0 * aj * bj) * c;
   }
-  const long long x0 = texel_floor(x_min), x1 = texel_floor(x_max);
-  const long long y0 = texel_floor(y_min), y1 = texel_floor(y_max);
-  if (p.n < 3 || x1 - x0 >= kMaxCells || y1 - y0 >= kMaxCells ||
-      (x1 - x0 + 1) * (y1 - y0 + 1) > kMaxCells) {
+  m.m1 *= 1.0 / 2.0;
+  m.ma *= 1.0 / 6.0;
+  m.mb *= 1.0 / 6.0;
+  m.mab *= 1.0 / 24.0;
+  return m;
+}
+
+/// Texel values g_0..g_{n-1} along one axis (`stride` apart) rewritten in place as the
+/// coefficients of a basis with one kink per inner node k = s0 + 1, s0 + 2, ...:
+///   order 0 (NEAREST, steps):  g(s) = g_0 + sum_{x >= 1} (g_x - g_{x-1}) step(s - s0 - x)
+///   order 1 (LINEAR, ramps):   g(s) = g_0 + (g_1 - g_0)(s - s0)
+///                                     + sum_{x >= 2} (g_x - 2 g_{x-1} + g_{x-2}) r(s - s0 - x + 1)
+/// with r(d) = max(0, d): what the filter between texel centres is on [s0, s0 + n - 1].
+/// From the far end, so each difference reads the values before they change.
+void to_kink_basis(glm::dvec4* g, int n, int stride, int order) {
+  if (order == 0) {
+    for (int x = n - 1; x >= 1; --x) g[x * stride] -= g[(x - 1) * stride];
+    return;
+  }
+  for (int x = n - 1; x >= 2; --x) {
+    g[x * stride] = g[x * stride] - 2.0 * g[(x - 1) * stride] + g[(x - 2) * stride];
+  }
+  if (n >= 2) g[stride] -= g[0];
+}
+
+/// The mean of one level over `uv`, filtered NEAREST (order 0) or LINEAR (order 1), exactly.
+/// In s, t (s = u W for NEAREST, whose texel i is the cell [i, i + 1]; s = u W - 1/2 for
+/// LINEAR, whose texel centres are the integers) the filter over the cells the polygon's
+/// bounds reach is the texel block rewritten by to_kink_basis along both axes, times products
+/// A_x(s) B_y(t) of the basis functions. Each product's integral over the polygon P is a
+/// moment of a piece of P: with S_k = P n {s >= k} and T_l = P n {t >= l},
+///   steps:  int_P step(s - k) step(t - l) = M_1(S_k n T_l)
+///   ramps:  int_P r(s - k) r(t - l) = M_ab(S_k n T_l) about (k, l),
+///           int_P r(s - k) (t - t0) = M_ab(S_k) about (k, t0), and so on,
+/// so the pieces are P cut by at most two half-planes: one per inner node on each axis and one
+/// per pair, where clipping every cell would cut four per cell. The texels wrap as
+/// sample_level wraps them. Nothing when P has no area or its bounds reach more than
+/// kMaxCells cells.
+template <int kOrder>
+std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
+                                        const TextureSampler& sampler, const ConvexPolygon& uv) {
+  ConvexPolygon p = uv;
+  double s_min = HUGE_VAL, t_min = HUGE_VAL, s_max = -HUGE_VAL, t_max = -HUGE_VAL;
+  for (int i = 0; i < p.n; ++i) {
+    p.x[i] = p.x[i] * level.width - 0.5 * kOrder;
+    p.y[i] = p.y[i] * level.height - 0.5 * kOrder;
+    s_min = std::min(s_min, p.x[i]);
+    s_max = std::max(s_max, p.x[i]);
+    t_min = std::min(t_min, p.y[i]);
+    t_max = std::max(t_max, p.y[i]);
+  }
+  const long long i0 = texel_floor(s_min), i1 = texel_floor(s_max);
+  const long long j0 = texel_floor(t_min), j1 = texel_floor(t_max);
+  if (p.n < 3 || i1 - i0 >= kMaxCells || j1 - j0 >= kMaxCells ||
+      (i1 - i0 + 1) * (j1 - j0 + 1) > kMaxCells) {
     return std::nullopt;
   }
-  if (x0 == x1 && y0 == y1) {  // inside one texel: its value
-    if (!(polygon_area(p) > 1e-12)) return std::nullopt;
-    return decode(level.at(wrap_texel(x0, level.width, sampler.wrap_s),
-                           wrap_texel(y0, level.height, sampler.wrap_t)));
+  const int columns = int(i1 - i0) + 1, rows = int(j1 - j0) + 1;  // cells
+  const int n = columns + kOrder, m = rows + kOrder;              // texels, basis functions
+  glm::dvec4 c[kMaxTexels];
+  for (int y = 0; y < m; ++y) {
+    const int row = wrap_texel(j0 + y, level.height, sampler.wrap_t);
+    for (int x = 0; x < n; ++x) {
+      c[y * n + x] = decode(level.at(wrap_texel(i0 + x, level.width, sampler.wrap_s), row));
+    }
   }
-  // Column strips first, then each strip's rows: two half-planes per strip and two per
-  // cell, and only the rows a strip reaches.
+  for (int y = 0; y < m; ++y) to_kink_basis(c + y * n, n, 1, kOrder);
+  for (int x = 0; x < n; ++x) to_kink_basis(c + x, m, n, kOrder);
+  // Piece (ps, pt) is P cut at s >= i0 + ps (ps > 0) and t >= j0 + pt (pt > 0); the pieces
+  // shrink as ps or pt grows, so the first empty one ends its loop. A cut piece whose
+  // coefficients are all zero (the texels are constant, or linear for LINEAR, across its
+  // node) adds nothing, exactly, and is not cut.
+  const auto zero = [](const glm::dvec4& v) { return v == glm::dvec4(0.0); };
+  const auto column_is_zero = [&](int x) {
+    for (int y = 0; y < m; ++y) {
+      if (!zero(c[y * n + x])) return false;
+    }
+    return true;
+  };
+  const Moments whole = moments(p, double(i0), double(j0));
+  const double area = whole.m1;
+  if (!(std::fabs(area) > 1e-12)) return std::nullopt;
+  if (kOrder == 0 && n * m == 1) return c[0];  // inside one texel: its value
   glm::dvec4 sum(0.0);
-  double area = 0.0;
-  for (long long tx = x0; tx <= x1; ++tx) {
-    const ConvexPolygon strip =
-        clip_half_plane(clip_half_plane(p, 1.0, 0.0, -double(tx)), -1.0, 0.0, double(tx + 1));
-    if (strip.n < 3) continue;
-    double strip_y_min = HUGE_VAL, strip_y_max = -HUGE_VAL;
-    for (int i = 0; i < strip.n; ++i) {
-      strip_y_min = std::min(strip_y_min, strip.y[i]);
-      strip_y_max = std::max(strip_y_max, strip.y[i]);
-    }
-    const long long r0 = std::max(y0, texel_floor(strip_y_min));
-    const long long r1 = std::min(y1, texel_floor(strip_y_max));
-    const int column = wrap_texel(tx, level.width, sampler.wrap_s);
-    for (long long ty = r0; ty <= r1; ++ty) {
-      const double part =
-          r0 == r1 ? polygon_area(strip)
-                   : polygon_area(clip_half_plane(clip_half_plane(strip, 0.0, 1.0, -double(ty)),
-                                                  0.0, -1.0, double(ty + 1)));
-      if (!(part > 0.0)) continue;
-      sum += decode(level.at(column, wrap_texel(ty, level.height, sampler.wrap_t))) * part;
-      area += part;
+  for (int ps = 0; ps < columns; ++ps) {
+    const int x = ps + kOrder;  // the basis function of the cut at s = i0 + ps
+    if (ps > 0 && column_is_zero(x)) continue;
+    const double s0 = double(i0 + ps);
+    const ConvexPolygon column_piece = ps == 0 ? p : clip_half_plane(p, 1.0, 0.0, -s0);
+    if (column_piece.n < 3) break;
+    for (int pt = 0; pt < rows; ++pt) {
+      const int y = pt + kOrder;
+      if (pt > 0 && zero(c[y * n + x]) && (ps > 0 || zero(c[y * n]))) continue;
+      const double t0 = double(j0 + pt);
+      const ConvexPolygon piece =
+          pt == 0 ? column_piece : clip_half_plane(column_piece, 0.0, 1.0, -t0);
+      if (piece.n < 3) break;
+      const Moments q = ps == 0 && pt == 0 ? whole : moments(piece, s0, t0);
+      if constexpr (kOrder == 0) {
+        sum += c[y * n + x] * q.m1;
+      } else {
+        // The ramp basis functions on this piece: x = 1 ((s - i0) on P) or ps + 1
+        // (r(s - i0 - ps)), and the constant x = 0 on P alone; the same for y.
+        sum += c[y * n + x] * q.mab;
+        if (ps == 0) sum += c[y * n] * q.mb;
+        if (pt == 0) sum += c[x] * q.ma;
+        if (ps == 0 && pt == 0) sum += c[0] * q.m1;
+      }
     }
   }
-  if (!(area > 1e-12)) return std::nullopt;
   return sum / area;
+}
+
+std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
+                                        const TextureSampler& sampler, const ConvexPolygon& uv,
+                                        TextureFilter filter) {
+  return filter == TextureFilter::Nearest ? level_average<0>(level, decode, sampler, uv)
+                                          : level_average<1>(level, decode, sampler, uv);
 }
 
 }  // namespace
 
-std::optional<glm::dvec4> nearest_area_average(const Texture& texture,
-                                               const TextureSampler& sampler,
-                                               const ConvexPolygon& uv, double lod) {
+std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
+                                       const ConvexPolygon& uv, double lod) {
   if (texture.levels.empty()) return std::nullopt;
   const TexelDecoder decode(texture.srgb);
   const LevelChoice c = choose_levels(texture, sampler, lod);  // as sample_texture reads them
   const std::optional<glm::dvec4> a =
-      level_area_average(texture.levels[std::size_t(c.first)], decode, sampler, uv);
+      level_average(texture.levels[std::size_t(c.first)], decode, sampler, uv, c.filter);
   if (c.second < 0 || !a) return a;
   const std::optional<glm::dvec4> b =
-      level_area_average(texture.levels[std::size_t(c.second)], decode, sampler, uv);
+      level_average(texture.levels[std::size_t(c.second)], decode, sampler, uv, c.filter);
   if (!b) return std::nullopt;
   return *a * (1.0 - c.weight) + *b * c.weight;
 }

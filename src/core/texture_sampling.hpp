@@ -35,16 +35,16 @@ double texture_lod(const Texture& texture, const glm::dvec2& duv_dx, const glm::
 glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
                           const glm::dvec2& uv, double lod);
 
-/// The mean of a NEAREST-filtered texture over the polygon `uv` (in UV units) at level of
-/// detail `lod`: the levels and their blend chosen as sample_texture chooses them, and on each
-/// level the texels weighted by their exact overlap areas with the polygon,
-///   sum_texels texel x area(polygon n texel) / area(polygon),
-/// wrapped per texel as sample_texture wraps. What sample_texture averages to over the
-/// polygon's points, where the filter at `lod` is NEAREST (the caller's condition). Nothing
-/// when the polygon has no area or covers more than 64 texel cells of a level.
-std::optional<glm::dvec4> nearest_area_average(const Texture& texture,
-                                               const TextureSampler& sampler,
-                                               const ConvexPolygon& uv, double lod);
+/// The mean of `texture` over the polygon `uv` (in UV units) at level of detail `lod`: what
+/// sample_texture averages to over the polygon's points. The levels, their filter and their
+/// blend are chosen as sample_texture chooses them, and each level is integrated exactly:
+///   NEAREST  sum_texels texel x area(polygon n texel) / area(polygon);
+///   LINEAR   the bilinear filter integrated over the polygon's part in each cell between
+///            four texel centres (its moments 1, a, b, a b), divided by area(polygon);
+/// texels wrapped as sample_texture wraps them. Nothing when the polygon has no area or
+/// reaches more than 64 texel cells of a level.
+std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
+                                       const ConvexPolygon& uv, double lod);
 
 /// KHR_texture_transform applied to a UV: T(offset) R(rotation) S(scale) uv.
 glm::dvec2 transform_uv(const TextureTransform& transform, const glm::dvec2& uv);

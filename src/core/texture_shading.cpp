@@ -67,8 +67,8 @@ int grid_points_in(const TriangleSetup& t, int x, int y, double mu[16][3]) {
   return count;
 }
 
-/// A NEAREST-filtered slot averaged over the fragment at level of detail `lod`: the exact
-/// overlap average over the triangle's part of the pixel (nearest_area_average); where that
+/// A slot averaged over the fragment at level of detail `lod`: its exact mean over the
+/// triangle's part of the pixel mapped into the texture (area_average); where that
 /// declines (a part over more than 64 texels of a level), the mean of the lookups at the
 /// grid points in the triangle; with none, the lookup at `centre` (the slot's UV there).
 glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, const glm::vec2* uv,
@@ -80,7 +80,7 @@ glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, co
       const glm::dvec2 q = slot_uv(slot, uv, footprint.vertex_mu[i]);
       polygon.add(q.x, q.y);
     }
-    if (const auto mean = nearest_area_average(*slot.texture, slot.sampler, polygon, lod)) {
+    if (const auto mean = area_average(*slot.texture, slot.sampler, polygon, lod)) {
       return *mean;
     }
   }
@@ -95,8 +95,8 @@ glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, co
 }
 
 /// One slot's filtered texel: its UV set at the point, transformed, with the level of detail
-/// of the transformed derivatives. A NEAREST-filtered slot with a `footprint`: its average
-/// over the fragment at that level of detail (footprint_average).
+/// of the transformed derivatives. With a `footprint`: its average over the fragment at that
+/// level of detail (footprint_average).
 glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const TexturedCorners& corners,
                   const double mu[3], const WeightDerivatives& d,
                   const FragmentFootprint* footprint) {
@@ -111,9 +111,8 @@ glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const Texture
   dx = transform_duv(slot.transform, dx);
   dy = transform_duv(slot.transform, dy);
   const double lod = texture_lod(*slot.texture, dx, dy);
-  const TextureFilter filter = lod > 0.0 ? slot.sampler.min : slot.sampler.mag;
   p = transform_uv(slot.transform, p);
-  if (footprint == nullptr || filter != TextureFilter::Nearest) {
+  if (footprint == nullptr) {
     return sample_texture(*slot.texture, slot.sampler, p, lod);
   }
   return footprint_average(t, slot, uv, *footprint, p, lod);

@@ -81,24 +81,6 @@ std::array<const TextureSlot*, 14> all_slots(const SurfaceTextures& t) {
           t.iridescence_thickness};
 }
 
-/// Whether some slot of `t` filters NEAREST within a mip level.
-bool any_nearest_filtered(const SurfaceTextures& t) {
-  for (const TextureSlot* slot : all_slots(t)) {
-    if (slot != nullptr && (slot->sampler.min == TextureFilter::Nearest ||
-                            slot->sampler.mag == TextureFilter::Nearest)) {
-      return true;
-    }
-  }
-  return false;
-}
-
-/// The slots with the flag of coverage mode's averaged lookups set.
-SurfaceTextures surface_textures(const Material& m, bool lit) {
-  SurfaceTextures out = surface_slots(m, lit);
-  out.nearest_filtered = any_nearest_filtered(out);
-  return out;
-}
-
 bool any_texture(const SurfaceTextures& t) {
   for (const TextureSlot* slot : all_slots(t)) {
     if (slot != nullptr) return true;
@@ -111,7 +93,7 @@ bool any_texture(const SurfaceTextures& t) {
 bool GeometryFrontEnd::shows_textures(const Scene& scene) {
   for (const MeshInstance& instance : scene.meshes) {
     for (const Material& m : instance.materials) {
-      if (any_texture(surface_textures(m, scene.lit))) return true;
+      if (any_texture(surface_slots(m, scene.lit))) return true;
     }
   }
   return false;
@@ -194,7 +176,7 @@ void GeometryFrontEnd::prepare_lighting() {
   for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
     const std::vector<Material>& materials = scene_.meshes[i].materials;
     // All slots first: surfaces_ point into textures_[i], which must not move afterwards.
-    for (const Material& m : materials) textures_[i].push_back(surface_textures(m, scene_.lit));
+    for (const Material& m : materials) textures_[i].push_back(surface_slots(m, scene_.lit));
     for (std::size_t k = 0; k < materials.size(); ++k) {
       SurfaceShading surface = surface_shading(materials[k], &context_);
       if (!scene_.lit) surface.model = LitModel::Unlit;  // textured in a scene without lights

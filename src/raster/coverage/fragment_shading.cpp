@@ -1,4 +1,4 @@
-// Coverage mode's shading of a fragment with NEAREST-filtered textures (fragment_shading.hpp).
+// Coverage mode's shading of a fragment of a textured surface (fragment_shading.hpp).
 #include "raster/coverage/fragment_shading.hpp"
 
 #include "core/convex_polygon.hpp"
@@ -13,6 +13,19 @@ FragmentFootprint footprint_of(const TriangleSetup& t, int x, int y) {
   FragmentFootprint footprint;
   footprint.x = x;
   footprint.y = y;
+  // Most fragments cover their pixel: the part is the pixel, its corners' unclamped weights
+  // all >= 0, and there is nothing to clip.
+  static constexpr double kCorner[4][2] = {{0.0, 0.0}, {1.0, 0.0}, {1.0, 1.0}, {0.0, 1.0}};
+  bool whole = true;
+  for (int i = 0; i < 4 && whole; ++i) {
+    double* mu = footprint.vertex_mu[i];
+    whole = perspective_weights(t, x + kCorner[i][0], y + kCorner[i][1], false, mu) &&
+            mu[0] >= 0.0 && mu[1] >= 0.0 && mu[2] >= 0.0;
+  }
+  if (whole) {
+    footprint.vertex_count = 4;
+    return footprint;
+  }
   // Relative to the pixel's corner: small numbers, so the clip keeps its bits.
   ConvexPolygon triangle;
   for (int k = 0; k < 3; ++k) {
