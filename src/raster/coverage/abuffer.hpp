@@ -363,8 +363,9 @@ class ABufferTile {
   }
   /// Colour of a layer in front of everything else (abuffer_resolve.cpp).
   static glm::vec3 front_layer_color(const LayerSums& sums, glm::vec3 behind);
-  /// The log's running sums (kept while it was open) as the list's LayerSums.
-  LayerSums logged_sums(std::size_t pixel) const;
+  /// The log's layer sums (PixelLog::layer_color: shaded now, in arrival order) as the
+  /// list's LayerSums.
+  LayerSums logged_sums(std::size_t pixel, int x, int y) const;
   std::vector<Layer> layer_;
   std::vector<LayerSums> layer_sums_;
   std::vector<std::uint8_t> open_count_;    ///< per pixel, fragments in the open set

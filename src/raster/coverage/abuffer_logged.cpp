@@ -178,8 +178,8 @@ void ABufferTile::hand_log_to_list(std::size_t pixel, int x, int y) {
   }
 }
 
-ABufferTile::LayerSums ABufferTile::logged_sums(std::size_t pixel) const {
-  const PixelLog::LayerColor& c = log_.layer_color(pixel);
+ABufferTile::LayerSums ABufferTile::logged_sums(std::size_t pixel, int x, int y) const {
+  const PixelLog::LayerColor c = log_.layer_color(pixel, x, y);
   return LayerSums{
       log_.coverage_sum(pixel), {c.rgb[0], c.rgb[1], c.rgb[2]}, c.depth, 0.0, kNoConvexKey};
 }
@@ -202,7 +202,7 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
   if (log_.state(pixel) == LogState::Open && log_.one_convex_facing(pixel) &&
       log_.farthest(pixel) < opaque_near) {
     ++paths_.proven_layer;
-    const LayerSums sums = logged_sums(pixel);
+    const LayerSums sums = logged_sums(pixel, x, y);
     const glm::vec3 behind = opaque != nullptr ? shade_fragment(*opaque, x, y) : background;
     color_[pixel] = front_layer_color(sums, behind);
     depth_[pixel] = opaque != nullptr ? std::min(sums.depth, float(opaque_z_[pixel])) : sums.depth;
@@ -212,8 +212,7 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
   resolve_masked(pixel, x, y, background);
 }
 
-void ABufferTile::resolve_proven(std::size_t pixel, [[maybe_unused]] int x,
-                                 [[maybe_unused]] int y) {
+void ABufferTile::resolve_proven(std::size_t pixel, int x, int y) {
   COVRAST_CHECK(
       [&] {
         const TriangleSetup* tri[kMaxLoggedFragments];
@@ -234,7 +233,7 @@ void ABufferTile::resolve_proven(std::size_t pixel, [[maybe_unused]] int x,
       }(),
       "a proven layer's fragments are pairwise disjoint inside the pixel");
   // The log's running sums, kept as the open set's are (add_to_sums): the same bits.
-  const LayerSums sums = logged_sums(pixel);
+  const LayerSums sums = logged_sums(pixel, x, y);
   COVRAST_CHECK(sums.coverage >= std::uint32_t(kCoverageOne), "a proven layer fills its pixel");
   color_[pixel] = front_layer_color(sums, glm::vec3(0.0f));  // nothing of what is behind shows
   depth_[pixel] = sums.depth;

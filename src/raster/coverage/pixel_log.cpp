@@ -84,7 +84,7 @@ PixelLog::PixelLog(std::size_t pixels)
       head_(pixels),
       tail_(pixels),
       coverage_sum_(pixels),
-      sums_(pixels),
+      near_z_(pixels),
       convex_(pixels),
       key_sum_(pixels),
       far_(pixels),
@@ -107,7 +107,7 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   if (n == 0) {
     head_[pixel] = index;
     coverage_sum_[pixel] = 0;
-    sums_[pixel] = LayerColor{{0.0, 0.0, 0.0}, INFINITY};
+    near_z_[pixel] = INFINITY;
     convex_[pixel] = convex_key(t);
     key_sum_[pixel] = 0;
     far_[pixel] = -INFINITY;
@@ -124,13 +124,7 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   coverage_sum_[pixel] += coverage;
   const bool was_convex = convex_[pixel] != kNotConvex;
   if (convex_[pixel] != convex_key(t)) convex_[pixel] = kNotConvex;
-  // The running sums of a layer, as the list's open set keeps them (the same order and bits).
-  const glm::vec3 c = shade_fragment(t, x, y);
-  LayerColor& sums = sums_[pixel];
-  sums.rgb[0] += double(coverage) * c.r;
-  sums.rgb[1] += double(coverage) * c.g;
-  sums.rgb[2] += double(coverage) * c.b;
-  sums.depth = std::min(sums.depth, float(centre_z));
+  near_z_[pixel] = std::min(near_z_[pixel], float(centre_z));
   if (convex_[pixel] == kNotConvex) {
     // The keys are needed from the first fragment that is not of the one convex facing on;
     // then those of the fragments before it as well (their triangles are read again).
@@ -155,10 +149,22 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   }
 }
 
+PixelLog::LayerColor PixelLog::layer_color(std::size_t pixel, int x, int y) const {
+  // The running sums of a layer, as the list's open set keeps them (the same order and bits).
+  LayerColor sums{{0.0, 0.0, 0.0}, near_z_[pixel]};
+  for_each(pixel, [&](const LoggedFragment& f) {
+    const glm::vec3 c = shade_fragment(*f.triangle, x, y);
+    sums.rgb[0] += double(f.coverage) * c.r;
+    sums.rgb[1] += double(f.coverage) * c.g;
+    sums.rgb[2] += double(f.coverage) * c.b;
+  });
+  return sums;
+}
+
 std::size_t PixelLog::scratch_bytes() const {
-  return state_.size() * (sizeof(LogState) + sizeof(std::uint8_t) + 3 * sizeof(std::uint32_t) +
-                          sizeof(std::uint64_t) + 2 * sizeof(double) + sizeof(LayerColor) +
-                          sizeof(std::uint32_t)) +
+  return state_.size() *
+             (sizeof(LogState) + sizeof(std::uint8_t) + 3 * sizeof(std::uint32_t) +
+              sizeof(std::uint64_t) + 2 * sizeof(double) + sizeof(float) + sizeof(std::uint32_t)) +
          entries_.capacity() * sizeof(LoggedFragment);
 }
 

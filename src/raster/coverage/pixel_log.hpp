@@ -96,13 +96,16 @@ class PixelLog {
   int count(std::size_t pixel) const { return count_[pixel]; }
   /// A depth at or behind which nothing shows (a proven layer's farthest; +inf: none).
   double hidden_from(std::size_t pixel) const { return hidden_from_[pixel]; }
-  /// A proven layer's colour sums: sum(coverage_i * linear colour_i) in arrival order, and
-  /// the nearest centre depth.
+  /// A layer's colour sums over the pixel's fragments (all of them arrived while it was Open:
+  /// one arriving later turns it Mixed): sum(coverage_i * linear colour_i) in arrival order,
+  /// and the nearest centre depth. The colours are shaded here, not as the fragments arrive:
+  /// a pixel that turns Mixed or is handed to the list never needs them (the list shades
+  /// its own), and a textured fragment's shading is the costly part of coverage mode.
   struct LayerColor {
     double rgb[3];
     float depth;
   };
-  const LayerColor& layer_color(std::size_t pixel) const { return sums_[pixel]; }
+  LayerColor layer_color(std::size_t pixel, int x, int y) const;
   /// While Open: whether every fragment is of one convex surface and facing
   /// (TriangleSetup::convex_surface), whose pieces do not overlap: the list's open set takes
   /// them as disjoint without a test (docs/coverage.md, section 3a, on snapped slivers).
@@ -135,7 +138,7 @@ class PixelLog {
   std::vector<std::uint8_t> count_;
   std::vector<std::uint32_t> head_, tail_;
   std::vector<std::uint32_t> coverage_sum_;  ///< while Open
-  std::vector<LayerColor> sums_;             ///< while Open
+  std::vector<float> near_z_;                ///< while Open: the nearest centre depth
   std::vector<std::uint32_t> convex_;        ///< while Open: convex_key of all, or kNotConvex
   static constexpr std::uint32_t kNotConvex = 0xffffffffu;
   static std::uint32_t convex_key(const TriangleSetup& t) {
