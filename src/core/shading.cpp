@@ -335,6 +335,11 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
 }
 
 double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+  return surface_alpha_with(t, mu0, mu1, mu2, base_color_texture_alpha(t, mu0, mu1, mu2));
+}
+
+double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double mu2,
+                          double texture_alpha) {
   const ShadingRecord& r = *t.shading;
   // Equal vertex alphas stay exact (the weights need not sum to exactly 1), so that a
   // uniform alpha equal to the cutoff passes.
@@ -342,8 +347,7 @@ double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2)
       r.vertex_alpha[0] == r.vertex_alpha[1] && r.vertex_alpha[0] == r.vertex_alpha[2]
           ? r.vertex_alpha[0]
           : mu0 * r.vertex_alpha[0] + mu1 * r.vertex_alpha[1] + mu2 * r.vertex_alpha[2];
-  const double texture = base_color_texture_alpha(t, mu0, mu1, mu2);
-  return r.surface->base_alpha * vertex * texture;
+  return r.surface->base_alpha * vertex * texture_alpha;
 }
 
 ShadedColor shade_rgba(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {

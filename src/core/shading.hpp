@@ -72,6 +72,9 @@ inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool cl
 ///   alpha = base_alpha x (mu0 a0 + mu1 a1 + mu2 a2) x texture alpha (1 until textures),
 /// a_i the vertex alphas (COLOR_0's fourth component). Out of line (core/shading.cpp).
 double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2);
+/// The same with the base colour texture's alpha given (`texture_alpha`, 1 without one).
+double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double mu2,
+                          double texture_alpha);
 
 /// Colour and alpha of a shading point.
 struct ShadedColor {

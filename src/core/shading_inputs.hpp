@@ -6,6 +6,7 @@
 // The formulas are in docs/shading.md; all arithmetic is double, IEEE, no contraction.
 #pragma once
 
+#include "core/texture_sampling.hpp"
 #include "core/tone_map.hpp"
 #include "core/triangle_setup.hpp"
 
@@ -79,6 +80,10 @@ struct FragmentFootprint {
   static constexpr int kMaxVertices = 7;  ///< a triangle clipped to a square
   double vertex_mu[kMaxVertices][3];
   int vertex_count = 0;
+  /// A base colour texel to use instead of the average (a MASK fragment's mean over the
+  /// points whose alpha passes: the texels the cutoff removes must not tint it).
+  bool has_base_color = false;
+  glm::dvec4 base_color{1.0};
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).
@@ -168,9 +173,17 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
                              const glm::dvec3& normal,
                              const FragmentFootprint* footprint = nullptr);
 
-/// The base colour texture's filtered alpha at the weights mu0..mu2 (1 without one): the
-/// texture term of surface_alpha, sampled exactly as sample_surface samples it.
+/// The base colour texture's filtered texel at the weights mu0..mu2 (1 without one), sampled
+/// exactly as sample_surface samples it; its alpha is the texture term of surface_alpha.
+glm::dvec4 base_color_texel(const TriangleSetup& t, double mu0, double mu1, double mu2);
+/// Its alpha.
 double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2);
+
+/// Bounds of that alpha over `footprint` at the level of detail of mu0..mu2 (the texels the
+/// lookups there read: area_alpha_range); [0, 1] where those are too many, [1, 1] without a
+/// texture.
+AlphaRange base_color_texture_alpha_range(const TriangleSetup& t, double mu0, double mu1,
+                                          double mu2, const FragmentFootprint& footprint);
 
 /// d(mu_i)/dx and d(mu_i)/dy of the perspective-correct barycentric weights of `t` at the
 /// point whose weights are mu0..mu2 (docs/textures.md has the derivation).

@@ -347,14 +347,29 @@ void to_kink_basis(glm::dvec4* g, int n, int stride, int order) {
 /// per pair, where clipping every cell would cut four per cell. The texels wrap as
 /// sample_level wraps them. Nothing when P has no area or its bounds reach more than
 /// kMaxCells cells.
-template <int kOrder>
-std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
-                                        const TextureSampler& sampler, const ConvexPolygon& uv) {
-  ConvexPolygon p = uv;
+/// The block of texels a filter of order 0 (NEAREST) or 1 (LINEAR) reads over a polygon:
+/// the polygon in s, t (s = u W for NEAREST, whose texel i is the cell [i, i + 1]; s = u W - 1/2
+/// for LINEAR, whose texel centres are the integers), the cells its bounds reach (first
+/// i0, j0) and their texels, decoded, row by row (columns + order per row).
+struct TexelBlock {
+  ConvexPolygon p;
+  long long i0 = 0, j0 = 0;
+  int columns = 0, rows = 0;  ///< cells
+  int n = 0, m = 0;           ///< texels per row, rows of texels
+  glm::dvec4 texel[kMaxTexels];
+};
+
+/// Fills `block` for `uv` on `level`; false when `uv` is not a polygon or its bounds reach
+/// more than kMaxCells cells.
+bool read_block(const TextureLevel& level, const TexelDecoder& decode,
+                const TextureSampler& sampler, const ConvexPolygon& uv, int order,
+                TexelBlock& block) {
+  ConvexPolygon& p = block.p;
+  p = uv;
   double s_min = HUGE_VAL, t_min = HUGE_VAL, s_max = -HUGE_VAL, t_max = -HUGE_VAL;
   for (int i = 0; i < p.n; ++i) {
-    p.x[i] = p.x[i] * level.width - 0.5 * kOrder;
-    p.y[i] = p.y[i] * level.height - 0.5 * kOrder;
+    p.x[i] = p.x[i] * level.width - 0.5 * order;
+    p.y[i] = p.y[i] * level.height - 0.5 * order;
     s_min = std::min(s_min, p.x[i]);
     s_max = std::max(s_max, p.x[i]);
     t_min = std::min(t_min, p.y[i]);
@@ -364,17 +379,33 @@ std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDe
   const long long j0 = texel_floor(t_min), j1 = texel_floor(t_max);
   if (p.n < 3 || i1 - i0 >= kMaxCells || j1 - j0 >= kMaxCells ||
       (i1 - i0 + 1) * (j1 - j0 + 1) > kMaxCells) {
-    return std::nullopt;
+    return false;
   }
-  const int columns = int(i1 - i0) + 1, rows = int(j1 - j0) + 1;  // cells
-  const int n = columns + kOrder, m = rows + kOrder;              // texels, basis functions
-  glm::dvec4 c[kMaxTexels];
-  for (int y = 0; y < m; ++y) {
+  block.i0 = i0;
+  block.j0 = j0;
+  block.columns = int(i1 - i0) + 1;
+  block.rows = int(j1 - j0) + 1;
+  block.n = block.columns + order;
+  block.m = block.rows + order;
+  for (int y = 0; y < block.m; ++y) {
     const int row = wrap_texel(j0 + y, level.height, sampler.wrap_t);
-    for (int x = 0; x < n; ++x) {
-      c[y * n + x] = decode(level.at(wrap_texel(i0 + x, level.width, sampler.wrap_s), row));
+    for (int x = 0; x < block.n; ++x) {
+      block.texel[y * block.n + x] =
+          decode(level.at(wrap_texel(i0 + x, level.width, sampler.wrap_s), row));
     }
   }
+  return true;
+}
+
+template <int kOrder>
+std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
+                                        const TextureSampler& sampler, const ConvexPolygon& uv) {
+  TexelBlock block;
+  if (!read_block(level, decode, sampler, uv, kOrder, block)) return std::nullopt;
+  const ConvexPolygon& p = block.p;
+  const long long i0 = block.i0, j0 = block.j0;
+  const int columns = block.columns, rows = block.rows, n = block.n, m = block.m;
+  glm::dvec4* c = block.texel;
   for (int y = 0; y < m; ++y) to_kink_basis(c + y * n, n, 1, kOrder);
   for (int x = 0; x < n; ++x) to_kink_basis(c + x, m, n, kOrder);
   // Piece (ps, pt) is P cut at s >= i0 + ps (ps > 0) and t >= j0 + pt (pt > 0); the pieces
@@ -429,7 +460,37 @@ std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDe
                                           : level_average<1>(level, decode, sampler, uv);
 }
 
+/// The smallest and largest alpha of the texels `filter` reads over `uv` on `level`.
+std::optional<AlphaRange> level_alpha_range(const TextureLevel& level, const TexelDecoder& decode,
+                                            const TextureSampler& sampler, const ConvexPolygon& uv,
+                                            TextureFilter filter) {
+  TexelBlock block;
+  if (!read_block(level, decode, sampler, uv, filter == TextureFilter::Nearest ? 0 : 1, block)) {
+    return std::nullopt;
+  }
+  AlphaRange range{HUGE_VAL, -HUGE_VAL};
+  for (int k = 0; k < block.n * block.m; ++k) {
+    range.low = std::min(range.low, block.texel[k].a);
+    range.high = std::max(range.high, block.texel[k].a);
+  }
+  return range;
+}
+
 }  // namespace
+
+std::optional<AlphaRange> area_alpha_range(const Texture& texture, const TextureSampler& sampler,
+                                           const ConvexPolygon& uv, double lod) {
+  if (texture.levels.empty()) return std::nullopt;
+  const TexelDecoder decode(texture.srgb);
+  const LevelChoice c = choose_levels(texture, sampler, lod);
+  std::optional<AlphaRange> a =
+      level_alpha_range(texture.levels[std::size_t(c.first)], decode, sampler, uv, c.filter);
+  if (c.second < 0 || !a) return a;
+  const std::optional<AlphaRange> b =
+      level_alpha_range(texture.levels[std::size_t(c.second)], decode, sampler, uv, c.filter);
+  if (!b) return std::nullopt;
+  return AlphaRange{std::min(a->low, b->low), std::max(a->high, b->high)};
+}
 
 std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
                                        const ConvexPolygon& uv, double lod) {

@@ -46,6 +46,19 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
 std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
                                        const ConvexPolygon& uv, double lod);
 
+/// Bounds of a filtered alpha: every value lies in [low, high].
+struct AlphaRange {
+  double low;
+  double high;
+};
+
+/// Bounds of `texture`'s filtered alpha over the polygon `uv` at level of detail `lod`: the
+/// smallest and largest alpha of the texels the lookups read there (each filter, and the
+/// blend of two levels, is a convex combination of them). Nothing where area_average would
+/// decline.
+std::optional<AlphaRange> area_alpha_range(const Texture& texture, const TextureSampler& sampler,
+                                           const ConvexPolygon& uv, double lod);
+
 /// KHR_texture_transform applied to a UV: T(offset) R(rotation) S(scale) uv.
 glm::dvec2 transform_uv(const TextureTransform& transform, const glm::dvec2& uv);
 /// Its linear part applied to a UV derivative: R(rotation) S(scale) d.

@@ -67,6 +67,17 @@ int grid_points_in(const TriangleSetup& t, int x, int y, double mu[16][3]) {
   return count;
 }
 
+/// The fragment's part of its pixel in a slot's (transformed) UVs.
+ConvexPolygon slot_polygon(const TextureSlot& slot, const glm::vec2* uv,
+                           const FragmentFootprint& footprint) {
+  ConvexPolygon polygon;
+  for (int i = 0; i < footprint.vertex_count; ++i) {
+    const glm::dvec2 q = slot_uv(slot, uv, footprint.vertex_mu[i]);
+    polygon.add(q.x, q.y);
+  }
+  return polygon;
+}
+
 /// A slot averaged over the fragment at level of detail `lod`: its exact mean over the
 /// triangle's part of the pixel mapped into the texture (area_average); where that
 /// declines (a part over more than 64 texels of a level), the mean of the lookups at the
@@ -75,12 +86,8 @@ glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, co
                              const FragmentFootprint& footprint, const glm::dvec2& centre,
                              double lod) {
   if (footprint.vertex_count >= 3) {
-    ConvexPolygon polygon;
-    for (int i = 0; i < footprint.vertex_count; ++i) {
-      const glm::dvec2 q = slot_uv(slot, uv, footprint.vertex_mu[i]);
-      polygon.add(q.x, q.y);
-    }
-    if (const auto mean = area_average(*slot.texture, slot.sampler, polygon, lod)) {
+    if (const auto mean =
+            area_average(*slot.texture, slot.sampler, slot_polygon(slot, uv, footprint), lod)) {
       return *mean;
     }
   }
@@ -94,12 +101,16 @@ glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, co
   return sum / double(count);
 }
 
-/// One slot's filtered texel: its UV set at the point, transformed, with the level of detail
-/// of the transformed derivatives. With a `footprint`: its average over the fragment at that
-/// level of detail (footprint_average).
-glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const TexturedCorners& corners,
-                  const double mu[3], const WeightDerivatives& d,
-                  const FragmentFootprint* footprint) {
+/// A slot at one shading point: its UV set, the (transformed) UV there and the level of
+/// detail of the transformed derivatives.
+struct SlotPoint {
+  const glm::vec2* uv;
+  glm::dvec2 p;
+  double lod;
+};
+
+SlotPoint slot_point(const TextureSlot& slot, const TexturedCorners& corners, const double mu[3],
+                     const WeightDerivatives& d) {
   // check_scene refuses other sets; a scene built without it must still not read out of bounds.
   const glm::vec2* uv = corners.uv[slot.texcoord == 1 ? 1 : 0];
   glm::dvec2 p(0.0), dx(0.0), dy(0.0);
@@ -110,12 +121,17 @@ glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const Texture
   }
   dx = transform_duv(slot.transform, dx);
   dy = transform_duv(slot.transform, dy);
-  const double lod = texture_lod(*slot.texture, dx, dy);
-  p = transform_uv(slot.transform, p);
-  if (footprint == nullptr) {
-    return sample_texture(*slot.texture, slot.sampler, p, lod);
-  }
-  return footprint_average(t, slot, uv, *footprint, p, lod);
+  return {uv, transform_uv(slot.transform, p), texture_lod(*slot.texture, dx, dy)};
+}
+
+/// One slot's filtered texel at its point (slot_point). With a `footprint`: its average over
+/// the fragment at that level of detail (footprint_average).
+glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const TexturedCorners& corners,
+                  const double mu[3], const WeightDerivatives& d,
+                  const FragmentFootprint* footprint) {
+  const SlotPoint at = slot_point(slot, corners, mu, d);
+  if (footprint == nullptr) return sample_texture(*slot.texture, slot.sampler, at.p, at.lod);
+  return footprint_average(t, slot, at.uv, *footprint, at.p, at.lod);
 }
 
 /// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
@@ -179,13 +195,32 @@ void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
 
 }  // namespace
 
-double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+glm::dvec4 base_color_texel(const TriangleSetup& t, double mu0, double mu1, double mu2) {
   const ShadingRecord& r = *t.shading;
-  if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return 1.0;
+  if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return glm::dvec4(1.0);
   const double mu[3] = {mu0, mu1, mu2};
   return lookup(t, *r.surface->textures->base_color, *r.textured, mu,
-                weight_derivatives(t, mu0, mu1, mu2), nullptr)
-      .a;
+                weight_derivatives(t, mu0, mu1, mu2), nullptr);
+}
+
+double base_color_texture_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2) {
+  return base_color_texel(t, mu0, mu1, mu2).a;
+}
+
+AlphaRange base_color_texture_alpha_range(const TriangleSetup& t, double mu0, double mu1,
+                                          double mu2, const FragmentFootprint& footprint) {
+  const ShadingRecord& r = *t.shading;
+  if (r.textured == nullptr || r.surface->textures->base_color == nullptr) return {1.0, 1.0};
+  const TextureSlot& slot = *r.surface->textures->base_color;
+  const double mu[3] = {mu0, mu1, mu2};
+  const SlotPoint at = slot_point(slot, *r.textured, mu, weight_derivatives(t, mu0, mu1, mu2));
+  if (footprint.vertex_count >= 3) {
+    if (const auto range = area_alpha_range(*slot.texture, slot.sampler,
+                                            slot_polygon(slot, at.uv, footprint), at.lod)) {
+      return *range;
+    }
+  }
+  return {0.0, 1.0};  // texels hold alphas in [0, 1]
 }
 
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
@@ -210,8 +245,11 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.iridescence_thickness_nm = s.iridescence_thickness_nm;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
-  if (slots.base_color != nullptr)
-    out.base_color = lookup(t, *slots.base_color, corners, mu, d, footprint);
+  if (slots.base_color != nullptr) {
+    out.base_color = footprint != nullptr && footprint->has_base_color
+                         ? footprint->base_color
+                         : lookup(t, *slots.base_color, corners, mu, d, footprint);
+  }
   if (slots.metallic_roughness != nullptr) {
     const glm::dvec4 v = lookup(t, *slots.metallic_roughness, corners, mu, d, footprint);
     out.roughness *= v.g;

@@ -133,7 +133,7 @@ bool ABufferTile::uniform_transparency(std::size_t pixel, int x, int y, double& 
   transmit = 1.0;
   light = glm::dvec3(0.0);
   for (const Layer1& layer : layers) {
-    const ShadedColor c = shade_rgba(*layer.t, x + 0.5, y + 0.5, true);
+    const ShadedColor c = shade_fragment_rgba(*layer.t, x, y);
     const double alpha = std::clamp(c.alpha, 0.0, 1.0);
     light += transmit * alpha * glm::dvec3(c.rgb);
     transmit *= 1.0 - alpha;
@@ -173,7 +173,7 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
   clear.clear();
   for (std::uint32_t f = transparent_head_[pixel]; f != kEnd; f = transparent_pool_[f].next) {
     const TriangleSetup* t = transparent_pool_[f].triangle;
-    const ShadedColor c = shade_rgba(*t, x + 0.5, y + 0.5, true);
+    const ShadedColor c = shade_fragment_rgba(*t, x, y);
     const SampleMask mask = pixel_sample_mask(*t, x, y);
     clear.push_back(Clear{t, double(transparent_pool_[f].coverage) / kCoverageOne,
                           std::clamp(c.alpha, 0.0, 1.0), c.rgb, mask, mask.count()});

@@ -11,6 +11,7 @@
 #include "core/tile_raster.hpp"
 #include "raster/coverage/abuffer.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
+#include "raster/coverage/fragment_shading.hpp"
 #include "raster/rasterizers.hpp"
 
 #include <algorithm>
@@ -149,23 +150,26 @@ class CoverageRasterizer final : public TileRasterizer {
     }
   }
 
-  /// A fragment of a MASK or BLEND triangle. MASK: kept where the alpha at the shading point
-  /// (the pixel centre clamped into the triangle) is >= the cutoff, then opaque. BLEND:
-  /// coverage mode keeps it in the A-buffer's transparent list; coverage-blend (the seed)
-  /// blends it over the frame buffer in draw order with alpha8 x alpha and does not write
-  /// the depth, as a GPU would.
+  /// A fragment of a MASK or BLEND triangle. Coverage mode: a MASK fragment whose alpha is
+  /// surely on one side of the cutoff is kept as an opaque fragment or dropped; one that
+  /// straddles it goes, with BLEND's, to the A-buffer's transparent list, whose resolve gives
+  /// it the share that passes as its alpha (mask_share). Coverage-blend (the seed): MASK kept where
+  /// the alpha at the pixel centre clamped into the triangle passes, then opaque; BLEND blended
+  /// over the frame buffer in draw order with alpha8 x alpha, without writing the depth, as a GPU
+  /// would.
   void alpha_fragment(const TriangleSetup& t, int x, int y, std::uint32_t coverage,
                       double centre_z) {
-    const double cx = x + 0.5, cy = y + 0.5;
-    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps(t, cx, cy, true)) return;
     if (!blend_) {
-      if (t.alpha_mode == TriangleAlpha::Blend) {
+      const MaskVerdict verdict = mask_verdict(t, x, y);  // Keep for BLEND
+      if (t.alpha_mode == TriangleAlpha::Blend || verdict == MaskVerdict::Straddles) {
         abuffer_.add_transparent(x, y, &t, coverage, centre_z);
-      } else {
+      } else if (verdict == MaskVerdict::Keep) {
         abuffer_.add(x, y, &t, coverage, centre_z);
       }
       return;
     }
+    const double cx = x + 0.5, cy = y + 0.5;
+    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps(t, cx, cy, true)) return;
     const std::size_t i = std::size_t(y - rect_.y0) * tile_px_ + (x - rect_.x0);
     const float z = float(t.depth_at(cx, cy));
     if (!(z < depth_[i])) return;

@@ -3,6 +3,9 @@
 
 #include "core/convex_polygon.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace covrast::detail {
 
 namespace {
@@ -45,7 +48,99 @@ FragmentFootprint footprint_of(const TriangleSetup& t, int x, int y) {
   return footprint;
 }
 
+/// Bounds of a MASK triangle's alpha (base x vertex x texture) over the fragment: the
+/// vertex alpha, a convex combination of the corners', between their extremes.
+AlphaRange surface_alpha_range(const TriangleSetup& t, const double mu[3],
+                               const FragmentFootprint& footprint) {
+  const ShadingRecord& r = *t.shading;
+  const auto [v_low, v_high] =
+      std::minmax({r.vertex_alpha[0], r.vertex_alpha[1], r.vertex_alpha[2]});
+  const AlphaRange texture = base_color_texture_alpha_range(t, mu[0], mu[1], mu[2], footprint);
+  AlphaRange range{HUGE_VAL, -HUGE_VAL};
+  for (const double v : {double(v_low), double(v_high)}) {
+    for (const double a : {texture.low, texture.high}) {
+      const double product = r.surface->base_alpha * v * a;
+      range.low = std::min(range.low, product);
+      range.high = std::max(range.high, product);
+    }
+  }
+  return range;
+}
+
 }  // namespace
+
+MaskVerdict mask_verdict(const TriangleSetup& t, int x, int y) {
+  if (t.alpha_mode != TriangleAlpha::Mask) return MaskVerdict::Keep;
+  const double cutoff = t.shading->surface->alpha_cutoff;
+  double mu[3];
+  perspective_weights(t, x + 0.5, y + 0.5, true, mu);
+  const FragmentFootprint footprint = footprint_of(t, x, y);
+  if (footprint.vertex_count < 3) {  // a sliver: the clamped centre's verdict
+    return surface_alpha(t, mu[0], mu[1], mu[2]) >= cutoff ? MaskVerdict::Keep : MaskVerdict::Drop;
+  }
+  const AlphaRange range = surface_alpha_range(t, mu, footprint);
+  if (range.low >= cutoff) return MaskVerdict::Keep;
+  if (range.high < cutoff) return MaskVerdict::Drop;
+  return MaskVerdict::Straddles;
+}
+
+MaskShare mask_share(const TriangleSetup& t, int x, int y) {
+  const double cutoff = t.shading->surface->alpha_cutoff;
+  MaskShare share;
+  int inside = 0, passing = 0;
+  double sum_x = 0.0, sum_y = 0.0;
+  glm::dvec4 sum_texel(0.0);
+  for (int j = 0; j < kMaskGrid; ++j) {
+    for (int i = 0; i < kMaskGrid; ++i) {
+      const double px = x + (i + 0.5) / kMaskGrid, py = y + (j + 0.5) / kMaskGrid;
+      double m[3];
+      // Unclamped weights are all >= 0 exactly where the point is in the triangle.
+      if (!perspective_weights(t, px, py, false, m) || m[0] < 0.0 || m[1] < 0.0 || m[2] < 0.0) {
+        continue;
+      }
+      ++inside;
+      const glm::dvec4 texel = base_color_texel(t, m[0], m[1], m[2]);
+      if (surface_alpha_with(t, m[0], m[1], m[2], texel.a) < cutoff) continue;
+      ++passing;
+      sum_x += px;
+      sum_y += py;
+      sum_texel += texel;
+    }
+  }
+  if (passing > 0) {
+    share.share = double(passing) / double(inside);
+    share.x_px = sum_x / passing;
+    share.y_px = sum_y / passing;
+    share.base_color = sum_texel / double(passing);
+  } else if (inside == 0) {  // no point in the triangle: the clamped centre's verdict
+    double mu[3];
+    perspective_weights(t, x + 0.5, y + 0.5, true, mu);
+    share.share = surface_alpha(t, mu[0], mu[1], mu[2]) >= cutoff ? 1.0 : 0.0;
+  }
+  return share;
+}
+
+ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
+  if (t.alpha_mode == TriangleAlpha::Mask && mask_verdict(t, x, y) == MaskVerdict::Straddles) {
+    const MaskShare share = mask_share(t, x, y);
+    double mu[3];
+    if (share.share > 0.0 && share.share < 1.0 &&
+        perspective_weights(t, share.x_px, share.y_px, true, mu)) {
+      // Shaded at the passing points' centroid with their mean base colour texel; the other
+      // textures averaged over the fragment.
+      FragmentFootprint footprint = footprint_of(t, x, y);
+      footprint.has_base_color = true;
+      footprint.base_color = share.base_color;
+      return {shade_lit(t, mu[0], mu[1], mu[2], &footprint), share.share};
+    }
+    return {shade_fragment(t, x, y), share.share};
+  }
+  const glm::vec3 rgb = shade_fragment(t, x, y);
+  if (t.alpha_mode != TriangleAlpha::Blend) return {rgb, 1.0};
+  double mu[3];
+  perspective_weights(t, x + 0.5, y + 0.5, true, mu);
+  return {rgb, surface_alpha(t, mu[0], mu[1], mu[2])};
+}
 
 glm::vec3 shade_fragment_averaged(const TriangleSetup& t, int x, int y) {
   double mu[3];

@@ -28,6 +28,36 @@ namespace covrast::detail {
 /// lookup. Out of line: it is the slow path.
 glm::vec3 shade_fragment_averaged(const TriangleSetup& t, int x, int y);
 
+/// Whether a MASK triangle keeps its fragment in pixel (x, y) (any other keeps it): Keep or
+/// Drop where its alpha over the fragment is surely on one side of the cutoff (bounds from
+/// the texels the base colour's lookups read there, the vertex alphas and the factor; for a
+/// fragment without area, the clamped centre's alpha), Straddles otherwise.
+enum class MaskVerdict { Keep, Drop, Straddles };
+MaskVerdict mask_verdict(const TriangleSetup& t, int x, int y);
+
+/// The points per side of the grid at which mask_share tests the alpha of a fragment that
+/// straddles the cutoff: 16 x 16, ssaa:16's samples.
+constexpr int kMaskGrid = 8;
+
+/// The share of a MASK fragment's part of the pixel where the alpha passes: of the points of
+/// a kMaskGrid x kMaskGrid grid of pixel (x, y) ((i + 1/2) / kMaskGrid) in the triangle, those
+/// where the alpha, looked up there as the reference and ssaa look it up, passes; and their
+/// centroid. With none of them in the triangle (a sliver), the clamped centre's verdict. The
+/// reference tests every one of its samples; one verdict per fragment (msaa, coverage-blend)
+/// cuts texture-driven edges a pixel at a time.
+struct MaskShare {
+  double share = 0.0;
+  double x_px = 0.0, y_px = 0.0;  ///< the passing points' centroid (share > 0)
+  glm::dvec4 base_color{1.0};     ///< their mean base colour texel (share > 0)
+};
+MaskShare mask_share(const TriangleSetup& t, int x, int y);
+
+/// The colour and alpha coverage mode gives the fragment of a MASK or BLEND triangle (the
+/// A-buffer's transparent list holds both). BLEND: the colour of shade_fragment, the surface
+/// alpha at the clamped centre. MASK: where it straddles the cutoff, mask_share's share as
+/// alpha, and the shading at its centroid with its mean base colour texel; else opaque.
+ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y);
+
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
 inline glm::vec3 shade_fragment(const TriangleSetup& t, int x, int y) {
   if (t.shading != nullptr && t.shading->textured != nullptr) {
