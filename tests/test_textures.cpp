@@ -1323,55 +1323,38 @@ int largest_difference(const covrast::Image& image, int size, const Expected& ex
 
 }  // namespace
 
-TEST_CASE("textures: coverage mode's NEAREST texture is the exact mean over the pixel",
-          "[textures]") {
-  // 64x64 random texels NEAREST, level 0 only, on a quad of 48x48 pixels: each pixel spans
-  // 4/3 texels, so one lookup per pixel (aliased, msaa) picks one texel where the pixel's
-  // mean blends up to four. Coverage mode weighs the texels by their overlap with each
-  // triangle's part of the pixel (raster/coverage/fragment_shading.hpp): the exact mean,
-  // on the quad's diagonal too.
+TEST_CASE("textures: coverage mode's texture is the exact mean over the pixel", "[textures]") {
+  // 64x64 random texels, level 0 only, on a quad of 48x48 pixels: each pixel spans 4/3
+  // texels. NEAREST: one lookup per pixel (aliased, msaa) picks one texel where the pixel's
+  // mean blends up to four. LINEAR: the bilinear filter bends at texel centres 3/4 of a pixel
+  // apart, so its value at the pixel centre is not the pixel's mean. Coverage mode
+  // integrates the filter over each triangle's part of the pixel
+  // (raster/coverage/fragment_shading.hpp, core/texture_sampling.hpp area_average): the exact
+  // mean, on the quad's diagonal too.
   const int size = 48, texels = 64;
-  const auto rgba = random_rgba(texels, texels, 11);
-  const covrast::Scene scene = nearest_quad_scene(size, texels, rgba);
-  const auto exact = [&](int px, int py, int c) {
-    return int(std::lround(srgb_encode_255(exact_pixel_mean(rgba, texels, size, px, py, c))));
-  };
-  const auto every_pixel = [](int, int) { return true; };
-  const int largest_coverage =
-      largest_difference(render_mode(scene, "coverage"), size, exact, every_pixel);
-  const int largest_aliased =
-      largest_difference(render_mode(scene, "aliased"), size, exact, every_pixel);
-  INFO("largest difference from the exact mean: coverage " << largest_coverage << ", aliased "
-                                                           << largest_aliased);
-  CHECK(largest_coverage <= 1);
-  CHECK(largest_aliased > 50);  // the scene does test something
-}
-
-TEST_CASE("textures: coverage mode's LINEAR texture is the exact mean over the pixel",
-          "[textures]") {
-  // 64x64 random texels LINEAR, level 0 only, on 48x48 pixels: the bilinear filter has kinks
-  // at texel centres 3/4 of a pixel apart, so its value at the pixel centre (aliased, msaa)
-  // is not the pixel's mean. Coverage mode integrates the filter over each triangle's part
-  // of the pixel (core/texture_sampling.hpp, area_average): the exact mean, diagonal too.
-  const int size = 48, texels = 64;
-  const auto rgba = random_rgba(texels, texels, 17);
-  const covrast::Scene scene =
-      quad_scene(size, slot_of(covrast::make_texture("noise", texels, texels, rgba, true),
-                               covrast::TextureFilter::Linear, covrast::TextureFilter::Linear,
-                               covrast::MipFilter::None));
-  const auto exact = [&](int px, int py, int c) {
-    return int(
-        std::lround(srgb_encode_255(exact_bilinear_pixel_mean(rgba, texels, size, px, py, c))));
-  };
-  const auto every_pixel = [](int, int) { return true; };
-  const int largest_coverage =
-      largest_difference(render_mode(scene, "coverage"), size, exact, every_pixel);
-  const int largest_aliased =
-      largest_difference(render_mode(scene, "aliased"), size, exact, every_pixel);
-  INFO("largest difference from the exact mean: coverage " << largest_coverage << ", aliased "
-                                                           << largest_aliased);
-  CHECK(largest_coverage <= 1);
-  CHECK(largest_aliased > 40);  // the scene does test something
+  for (const covrast::TextureFilter filter :
+       {covrast::TextureFilter::Nearest, covrast::TextureFilter::Linear}) {
+    const bool nearest = filter == covrast::TextureFilter::Nearest;
+    INFO((nearest ? "NEAREST" : "LINEAR"));
+    const auto rgba = random_rgba(texels, texels, nearest ? 11 : 17);
+    const covrast::Scene scene =
+        quad_scene(size, slot_of(covrast::make_texture("noise", texels, texels, rgba, true), filter,
+                                 filter, covrast::MipFilter::None));
+    const auto exact = [&](int px, int py, int c) {
+      const double mean = nearest ? exact_pixel_mean(rgba, texels, size, px, py, c)
+                                  : exact_bilinear_pixel_mean(rgba, texels, size, px, py, c);
+      return int(std::lround(srgb_encode_255(mean)));
+    };
+    const auto every_pixel = [](int, int) { return true; };
+    const int largest_coverage =
+        largest_difference(render_mode(scene, "coverage"), size, exact, every_pixel);
+    const int largest_aliased =
+        largest_difference(render_mode(scene, "aliased"), size, exact, every_pixel);
+    INFO("largest difference from the exact mean: coverage " << largest_coverage << ", aliased "
+                                                             << largest_aliased);
+    CHECK(largest_coverage <= 1);
+    CHECK(largest_aliased > 40);  // the scene does test something
+  }
 }
 
 TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa:4's points",
