@@ -1,5 +1,5 @@
 // Tests of the glTF material extensions covrast honours (docs/shading.md, "Material
-// extensions"): KHR_materials_ior, KHR_materials_specular and KHR_materials_clearcoat.
+// extensions"): KHR_materials_ior, _specular, _clearcoat, _sheen, _iridescence and _anisotropy.
 // - On the lit sphere of test_sphere_scene.hpp, every interior pixel in three modes against the
 //   extensions' formulas written out here from their specifications (not from covrast's code).
 // - The coat under the environment, the suns and the ambient light: the layering identity.
@@ -144,6 +144,32 @@ glm::dvec3 thin_film(double film_ior, const glm::dvec3& base_f0, double thicknes
   return out;
 }
 
+/// KHR_materials_anisotropy's D V, from the extension's D_GGX_anisotropic and
+/// V_GGX_anisotropic: the direction t is the sphere's tangent T = normalize(Y x n)
+/// (sphere_tangents) turned by the rotation towards B = n x T, b = n x t,
+///   alpha_t = mix(alpha, 1, strength^2), alpha_b = alpha, a = alpha_t alpha_b,
+///   D = a (a / |f|^2)^2 / pi,  f = (alpha_b t.h, alpha_t b.h, a n.h),
+///   V = min(0.5 / (n.l |(alpha_t t.v, alpha_b b.v, n.v)| + n.v |(alpha_t t.l, alpha_b b.l,
+///       n.l)|), 1).
+double anisotropic_dv(const Material& m, const glm::dvec3& n, const glm::dvec3& v,
+                      const glm::dvec3& l, const glm::dvec3& h) {
+  const glm::dvec3 tangent = glm::normalize(glm::cross(glm::dvec3(0.0, 1.0, 0.0), n));
+  const glm::dvec3 bitangent = glm::cross(n, tangent);
+  const double rotation = m.anisotropy_rotation;
+  const glm::dvec3 t = tangent * std::cos(rotation) + bitangent * std::sin(rotation);
+  const glm::dvec3 b = glm::cross(n, t);
+  const double alpha = std::max(double(m.roughness) * m.roughness, 1e-3);
+  const double strength2 = double(m.anisotropy) * m.anisotropy;
+  const double at = alpha * (1.0 - strength2) + strength2, ab = alpha, a = at * ab;
+  const glm::dvec3 f(ab * glm::dot(t, h), at * glm::dot(b, h), a * glm::dot(n, h));
+  const double w2 = a / glm::dot(f, f);
+  const double d = a * w2 * w2 / kPi;
+  const double n_l = glm::dot(n, l), n_v = glm::dot(n, v);
+  const double ggx_v = n_l * glm::length(glm::dvec3(at * glm::dot(t, v), ab * glm::dot(b, v), n_v));
+  const double ggx_l = n_v * glm::length(glm::dvec3(at * glm::dot(t, l), ab * glm::dot(b, l), n_l));
+  return d * std::min(0.5 / (ggx_v + ggx_l), 1.0);
+}
+
 /// The lit sphere's sun and sky.
 const glm::dvec3 kSunDirection = glm::normalize(glm::dvec3(-0.3, -0.4, -1.0));
 constexpr double kSun = 2.0, kSky = 0.1;
@@ -176,7 +202,9 @@ glm::dvec3 extended_pbr(const Material& m, const glm::dvec3& base, const glm::dv
   }
   const double max_f0_d = std::max({f0_d.r, f0_d.g, f0_d.b});
   const double alpha = std::max(double(m.roughness) * m.roughness, 1e-3);
-  const double dv = ggx_d(alpha, n_h) * smith_v(alpha, n_l, n_v, h_l, h_v);
+  const double dv = m.anisotropy > 0.0f && n_l > 0.0
+                        ? anisotropic_dv(m, n, v, l, h)
+                        : ggx_d(alpha, n_h) * smith_v(alpha, n_l, n_v, h_l, h_v);
   // KHR_materials_iridescence: dielectric = rgb_mix(diffuse, specular, mix(F_d, Ir_d, k)),
   // metal = specular x mix(F_m, Ir_m, k), Ir at n . v over F0_d and over the base.
   const double k = m.iridescence;
@@ -232,9 +260,25 @@ glm::dvec3 extended_pbr(const Material& m, const glm::dvec3& base, const glm::dv
   return out;
 }
 
-/// The lit sphere with `m`, sun and sky.
+/// The sphere's tangents at its corners, T = normalize(Y x p) (along the parallels, w = 1;
+/// (1, 0, 0) at the poles, which no interior pixel sees).
+void sphere_tangents(covrast::Scene& scene) {
+  auto mesh = std::make_shared<covrast::MeshData>(*scene.meshes.at(0).mesh);
+  mesh->corner_tangents.clear();
+  for (const std::uint32_t i : mesh->indices) {
+    const glm::dvec3 p(mesh->positions[i]);
+    const glm::dvec3 t = glm::cross(glm::dvec3(0.0, 1.0, 0.0), p);
+    const double length = glm::length(t);
+    mesh->corner_tangents.push_back(length > 1e-9 ? glm::vec4(glm::vec3(t / length), 1.0f)
+                                                  : glm::vec4(1, 0, 0, 1));
+  }
+  scene.meshes[0].mesh = mesh;
+}
+
+/// The lit sphere with `m`, sun and sky, and tangents.
 covrast::Scene extension_sphere(const glm::dvec3& base, const Material& m) {
   covrast::Scene scene = covrast::test::lit_sphere_scene(glm::vec3(base), m);
+  sphere_tangents(scene);
   Light sun;
   sun.type = LightType::Directional;
   sun.direction = kSunDirection;
@@ -298,7 +342,7 @@ int worst_difference(
 
 }  // namespace
 
-TEST_CASE("ior specular clearcoat sheen and iridescence on a lit sphere match their formulas",
+TEST_CASE("ior specular clearcoat sheen iridescence anisotropy on a lit sphere match formulas",
           "[shading][analytic][extensions]") {
   struct Case {
     const char* name;
@@ -368,6 +412,23 @@ TEST_CASE("ior specular clearcoat sheen and iridescence on a lit sphere match th
     m.iridescence = 0.6f;
     m.iridescence_ior = 1.8f;
     m.iridescence_thickness_max_nm = 250.0f;
+  });
+  add("anisotropy 0.8 along the tangent", [](Material& m) {
+    m.roughness = 0.45f;
+    m.anisotropy = 0.8f;
+  });
+  add("anisotropy 0.5 over a metal, turned by 1 radian", [](Material& m) {
+    m.metallic = 1.0f;
+    m.roughness = 0.35f;
+    m.anisotropy = 0.5f;
+    m.anisotropy_rotation = 1.0f;
+  });
+  add("anisotropy 1 turned a quarter turn, under a clear coat", [](Material& m) {
+    m.roughness = 0.3f;
+    m.anisotropy = 1.0f;
+    m.anisotropy_rotation = float(kPi / 2.0);
+    m.clearcoat = 0.5f;
+    m.clearcoat_roughness = 0.2f;
   });
   const glm::dvec3 base(0.6, 0.3, 0.2);
   for (const Case& c : cases) {
@@ -518,7 +579,8 @@ TEST_CASE("glTF material extensions at their neutral values draw today's bytes",
       {"KHR_materials_specular", {{"specularFactor", 1.0}, {"specularColorFactor", {1, 1, 1}}}},
       {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}, {"clearcoatRoughnessFactor", 0.4}}},
       {"KHR_materials_sheen", {{"sheenColorFactor", {0, 0, 0}}, {"sheenRoughnessFactor", 0.5}}},
-      {"KHR_materials_iridescence", {{"iridescenceFactor", 0.0}, {"iridescenceIor", 1.6}}}};
+      {"KHR_materials_iridescence", {{"iridescenceFactor", 0.0}, {"iridescenceIor", 1.6}}},
+      {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.0}, {"anisotropyRotation", 0.7}}}};
   std::ofstream(dir / "neutral.glb", std::ios::binary) << sphere_gltf(neutral);
   nlohmann::json coated = neutral;
   coated["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.0;
@@ -557,7 +619,11 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
                                 {"iridescenceThicknessMinimum", 150.0},
                                 {"iridescenceThicknessMaximum", 650.0},
                                 {"iridescenceTexture", {{"index", 0}}},
-                                {"iridescenceThicknessTexture", {{"index", 0}}}}}};
+                                {"iridescenceThicknessTexture", {{"index", 0}}}}},
+                              {"KHR_materials_anisotropy",
+                               {{"anisotropyStrength", 0.625},
+                                {"anisotropyRotation", -2.5},
+                                {"anisotropyTexture", {{"index", 0}}}}}};
   std::ofstream(dir / "all.glb", std::ios::binary) << sphere_gltf(all);
   const covrast::Scene scene = covrast::load_mesh_scene(dir / "all.glb", 32, 32);
   for (const std::string& warning : scene.warnings)
@@ -587,6 +653,10 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
   CHECK(m.iridescence_thickness_max_nm == 650.0f);
   REQUIRE(m.iridescence_texture.texture);
   REQUIRE(m.iridescence_thickness_texture.texture);
+  CHECK(m.anisotropy == 0.625f);
+  CHECK(m.anisotropy_rotation == -2.5f);
+  REQUIRE(m.anisotropy_texture.texture);
+  CHECK_FALSE(m.anisotropy_texture.texture->srgb);
   // The textured coat draws: the coat texture's R (200/255) scales clearcoatFactor, so it
   // differs from the same file without the coat texture.
   nlohmann::json untextured = all;
@@ -626,6 +696,12 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
        path + "KHR_materials_iridescence.iridescenceThicknessMaximum: expected a number in 0.."},
       {{{"KHR_materials_iridescence", {{"iridescenceFactor", {1}}}}},
        path + "KHR_materials_iridescence.iridescenceFactor: expected a number in 0..1"},
+      {{{"KHR_materials_anisotropy", {{"anisotropyStrength", 1.5}}}},
+       path + "KHR_materials_anisotropy.anisotropyStrength: expected a number in 0..1"},
+      {{{"KHR_materials_anisotropy", {{"anisotropyRotation", "1"}}}},
+       path + "KHR_materials_anisotropy.anisotropyRotation: expected a number in"},
+      {{{"KHR_materials_anisotropy", {{"anisotropyTexture", -1}}}},
+       path + "KHR_materials_anisotropy.anisotropyTexture: expected a textureInfo object"},
       {{{"KHR_materials_ior", {{"ior", 0.5}}}},
        path + "KHR_materials_ior.ior: expected 0 or a number >= 1"},
       {{{"KHR_materials_ior", {{"ior", "1.5"}}}},
@@ -655,7 +731,8 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
       "meshes": [{"obj": "t.obj", "material": {"model": "pbr", "ior": 0, "specular_factor": 0.5,
                   "clearcoat": 1, "clearcoat_roughness": 0.25, "sheen_color": [1, 0.5, 0],
                   "sheen_roughness": 0.5, "iridescence": 0.25, "iridescence_ior": 1.5,
-                  "iridescence_thickness_nm": 500}}]})";
+                  "iridescence_thickness_nm": 500, "anisotropy": 0.75,
+                  "anisotropy_rotation_deg": -90}}]})";
   const covrast::Scene scene = covrast::load_scene(dir / "s.json");
   const Material& m = scene.meshes.at(0).materials.at(0);
   CHECK(m.ior == 0.0f);
@@ -668,6 +745,11 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
   CHECK(m.iridescence == 0.25f);
   CHECK(m.iridescence_ior == 1.5f);
   CHECK(m.iridescence_thickness_max_nm == 500.0f);
+  CHECK(m.anisotropy == 0.75f);
+  CHECK(m.anisotropy_rotation == float(-kPi / 2.0));
+  // The OBJ has neither tangents nor UVs: no tangent frame, said once.
+  REQUIRE(scene.warnings.size() == 1);
+  CHECK_THAT(scene.warnings[0], Contains("meshes[0]: anisotropy needs a tangent frame"));
 }
 
 TEST_CASE("the sheen under the studio environment against quadrature over its texels",
@@ -734,4 +816,78 @@ TEST_CASE("the sheen under the studio environment against quadrature over its te
   CHECK(worst < 0.09);
   CHECK(rms < 0.025);
   CHECK(rms < 0.25 * rms_without);
+}
+
+TEST_CASE("anisotropy's texture gives its direction and strength in the tangent frame",
+          "[gltf][extensions]") {
+  // sphere_gltf's texture holds (200, 100, 50) (linear): direction (2 x 200/255 - 1,
+  // 2 x 100/255 - 1) in the frame the UVs give (no TANGENT), strength x 50/255. The same file
+  // without the texture, with that direction as its rotation and that strength as its factor,
+  // draws the same pixels; turned back to the tangent it does not.
+  covrast::test::TempDir dir("covrast-anisotropy-texture");
+  const double dx = 2.0 * 200.0 / 255.0 - 1.0, dy = 2.0 * 100.0 / 255.0 - 1.0;
+  const auto file = [&](const char* name, double strength, double rotation, bool textured) {
+    nlohmann::json e = {{"anisotropyStrength", strength}, {"anisotropyRotation", rotation}};
+    if (textured) e["anisotropyTexture"] = {{"index", 0}};
+    std::ofstream(dir / name, std::ios::binary) << sphere_gltf({{"KHR_materials_anisotropy", e}});
+    return dir / name;
+  };
+  const auto textured = file("textured.glb", 0.9, 0.0, true);
+  const auto turned = file("turned.glb", 0.9 * 50.0 / 255.0, std::atan2(dy, dx), false);
+  const auto along_tangent = file("tangent.glb", 0.9 * 50.0 / 255.0, 0.0, false);
+  for (const char* mode : {"aliased", "coverage"}) {
+    INFO(mode);
+    const covrast::Image a = render_lit(textured, mode), b = render_lit(turned, mode);
+    REQUIRE(a.rgb.size() == b.rgb.size());
+    int worst = 0;
+    for (std::size_t i = 0; i < a.rgb.size(); ++i)
+      worst = std::max(worst, std::abs(a.rgb[i] - b.rgb[i]));
+    CHECK(worst <= 1);
+    CHECK((render_lit(along_tangent, mode).rgb != a.rgb));
+  }
+}
+
+TEST_CASE("anisotropy under the environment reads it about the bent normal",
+          "[shading][extensions][environment]") {
+  // The environment's specular part with the prefiltered radiance read about the bent normal
+  // of the glTF Sample Viewer and Filament, written out here: with b = n x t,
+  //   n_a = (b x v) x b,  bend = (1 - strength (1 - roughness))^4,
+  //   n_bent = normalize(mix(n_a, n, bend)),
+  // and for a metal (c_diff = 0, F0 = base) L = F0 A + (1 - F0) B with A, B read there.
+  using namespace covrast::detail;
+  const covrast::EnvironmentLight light{covrast::studio_environment(), 20.0, 1.0};
+  const EnvironmentLighting lighting(light);
+  REQUIRE(lighting.suns().empty());
+  ShadingContext context;
+  context.environment = &lighting;
+  SurfaceShading s;
+  s.model = LitModel::Pbr;
+  s.metallic = 1.0;  // a metal: F0 = base, no diffuse, so the specular is all there is
+  s.roughness = 0.3;
+  s.context = &context;
+  s.anisotropy = 0.7;
+  SurfaceShading isotropic = s;
+  isotropic.anisotropy = 0.0;
+  const glm::dvec3 base(0.9, 0.7, 0.5);
+  int bent_shows = 0;
+  for (int k = 0; k < 24; ++k) {
+    const double z = 1.0 - (k + 0.5) / 12.0, phi = 2.399963 * k;
+    const glm::dvec3 n(std::sqrt(1.0 - z * z) * std::cos(phi), z,
+                       std::sqrt(1.0 - z * z) * std::sin(phi));
+    const glm::dvec3 v = glm::normalize(n + glm::dvec3(0.4 * std::sin(k), 0.3, 0.4 * std::cos(k)));
+    const glm::dvec3 t = glm::normalize(glm::cross(glm::dvec3(0.3, 1.0, 0.2), n));
+    context.eye_world = v * 4.0;
+    const glm::dvec3 b = glm::cross(n, t);
+    const glm::dvec3 n_a = glm::cross(glm::cross(b, v), b);
+    const double bend = std::pow(1.0 - s.anisotropy * (1.0 - s.roughness), 4.0);
+    const glm::dvec3 bent = glm::normalize(n_a * (1.0 - bend) + n * bend);
+    const EnvironmentIntegrals e = lighting.integrals(n, v, s.roughness, bent);
+    const glm::dvec3 want = base * e.specular + (glm::dvec3(1.0) - base) * e.specular_schlick;
+    const glm::dvec3 got = shade_point(s, base, glm::dvec3(0.0), n, n, t);
+    INFO("normal " << k);
+    for (int c = 0; c < 3; ++c) CHECK(got[c] == Approx(want[c]).epsilon(1e-9));
+    const glm::dvec3 plain = shade_point(isotropic, base, glm::dvec3(0.0), n, n, t);
+    bent_shows += glm::length(got - plain) > 1e-3;
+  }
+  CHECK(bent_shows >= 18);
 }

@@ -133,6 +133,14 @@ struct Material {
   float iridescence_thickness_max_nm = 400.0f;
   TextureSlot iridescence_texture;
   TextureSlot iridescence_thickness_texture;
+  /// KHR_materials_anisotropy: the specular lobe stretched along a direction in the surface:
+  /// strength (0..1; x the texture's B) raises the alpha roughness along it to mix(alpha, 1,
+  /// strength^2); the direction is the tangent turned by `anisotropy_rotation` [radians,
+  /// counter-clockwise towards the bitangent], or the texture's RG in [-1, 1] tangent space
+  /// turned alike. Needs a tangent frame (the mesh's tangents, else computed from UVs).
+  float anisotropy = 0.0f;
+  float anisotropy_rotation = 0.0f;
+  TextureSlot anisotropy_texture;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
@@ -143,7 +151,7 @@ struct Material {
   std::string base_color_texture_path;
 
   /// Every texture slot, in one order (for checks and listings that treat them alike).
-  std::array<const TextureSlot*, 14> texture_slots() const {
+  std::array<const TextureSlot*, 15> texture_slots() const {
     return {&base_color_texture,
             &metallic_roughness_texture,
             &normal_texture,
@@ -157,7 +165,8 @@ struct Material {
             &sheen_color_texture,
             &sheen_roughness_texture,
             &iridescence_texture,
-            &iridescence_thickness_texture};
+            &iridescence_thickness_texture,
+            &anisotropy_texture};
   }
 };
 

@@ -558,8 +558,8 @@ glm::dvec3 EnvironmentLighting::prefiltered_radiance(const glm::dvec3& r_map,
 }
 
 EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
-                                                    const glm::dvec3& v_world,
-                                                    double roughness) const {
+                                                    const glm::dvec3& v_world, double roughness,
+                                                    const glm::dvec3& mirror_normal_world) const {
   EnvironmentIntegrals out;
   out.irradiance = irradiance_without_suns(n_world);
   const glm::dvec3 n = to_map(n_world);
@@ -576,7 +576,12 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
 
   // Split sum: the radiance prefiltered around the mirror direction times the uniform-light
   // values, exact when L is uniform.
-  const glm::dvec3 prefiltered = prefiltered_radiance(n * (2.0 * mu) - v, roughness) * intensity_;
+  glm::dvec3 r = n * (2.0 * mu) - v;
+  if (mirror_normal_world != n_world) {
+    const glm::dvec3 mirror = to_map(mirror_normal_world);
+    r = mirror * (2.0 * glm::dot(mirror, v)) - v;
+  }
+  const glm::dvec3 prefiltered = prefiltered_radiance(r, roughness) * intensity_;
   out.specular = prefiltered * uniform[1];
   out.specular_schlick = prefiltered * uniform[2];
   return out;

@@ -69,7 +69,13 @@ class EnvironmentLighting {
   /// All four integrals, without the suns, for unit world-space n and v (n . v may be <= 0: then
   /// only E counts) and perceptual roughness in [0, 1].
   EnvironmentIntegrals integrals(const glm::dvec3& n_world, const glm::dvec3& v_world,
-                                 double roughness) const;
+                                 double roughness) const {
+    return integrals(n_world, v_world, roughness, n_world);
+  }
+  /// The same with the prefiltered radiance read around the mirror direction of v about
+  /// `mirror_normal_world` (unit) instead of n: KHR_materials_anisotropy's bent normal.
+  EnvironmentIntegrals integrals(const glm::dvec3& n_world, const glm::dvec3& v_world,
+                                 double roughness, const glm::dvec3& mirror_normal_world) const;
 
   /// The texels taken out of the map as directional lights (integrals() leaves them out;
   /// irradiance() includes them): each holds at least kSunPowerShare of the map's power.

@@ -55,6 +55,38 @@ inline GgxLobe ggx_lobe(const glm::dvec3& n, const glm::dvec3& v, const glm::dve
   return lobe;
 }
 
+/// KHR_materials_anisotropy's lobe for the unit frame t, b, n, unit v, l and roughnesses
+/// alpha_t along t, alpha_b along b (the extension's D_GGX_anisotropic and V_GGX_anisotropic,
+/// Filament's anisotropic model):
+///   D = a^3 / (pi |f|^4),  a = alpha_t alpha_b,  f = (alpha_b t.h, alpha_t b.h, a n.h)
+///   V = min(0.5 / (|n.l| |(alpha_t t.v, alpha_b b.v, |n.v|)| + |n.v| |(alpha_t t.l,
+///       alpha_b b.l, |n.l|)|), 1)
+/// with the isotropic lobe's conditions (0 where n.h, h.l or h.v <= 0). Its V is the
+/// height-correlated Smith term, where the core's is the separable one (ggx_lobe).
+inline GgxLobe anisotropic_ggx_lobe(const glm::dvec3& n, const glm::dvec3& t, const glm::dvec3& b,
+                                    const glm::dvec3& v, const glm::dvec3& l, double alpha_t,
+                                    double alpha_b) {
+  const glm::dvec3 h_sum = l + v;
+  const double h_length = glm::length(h_sum);
+  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
+  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
+  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l);
+  GgxLobe lobe;
+  lobe.h_dot_v = glm::dot(h, v);
+  if (n_dot_h > 0.0 && h_dot_l > 0.0 && lobe.h_dot_v > 0.0) {
+    const double a = alpha_t * alpha_b;
+    const glm::dvec3 f(alpha_b * glm::dot(t, h), alpha_t * glm::dot(b, h), a * n_dot_h);
+    const double w2 = a / glm::dot(f, f);
+    const double d = a * w2 * w2 / std::numbers::pi;
+    const double ggx_v = n_dot_l * glm::length(glm::dvec3(alpha_t * glm::dot(t, v),
+                                                          alpha_b * glm::dot(b, v), n_dot_v));
+    const double ggx_l = n_dot_v * glm::length(glm::dvec3(alpha_t * glm::dot(t, l),
+                                                          alpha_b * glm::dot(b, l), n_dot_l));
+    lobe.d_vis = d * std::min(0.5 / (ggx_v + ggx_l), 1.0);
+  }
+  return lobe;
+}
+
 /// KHR_materials_clearcoat's layer weight per unit clearcoat, fresnel_coat with ior 1.5:
 ///   Fc = 0.04 + (1 - 0.04) (1 - |n_c . v|)^5.
 inline double clearcoat_fresnel(const glm::dvec3& coat_normal, const glm::dvec3& v) {

@@ -71,6 +71,21 @@ glm::dvec3 environment_diffuse(const ShadingContext& c, double occlusion, const 
   return base * c.environment->irradiance(n) * (occlusion / kPi);
 }
 
+/// The normal the environment's prefiltered radiance is reflected about: n, or for
+/// KHR_materials_anisotropy the bent normal of the glTF Sample Viewer and Filament (the
+/// stretched lobe reflects light from along b): with a = b x v, n_a = a x b and
+///   bend = (1 - anisotropy (1 - roughness))^4,   n_bent = normalize(mix(n_a, n, bend)).
+glm::dvec3 mirror_normal(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v) {
+  if (!(m.anisotropy > 0.0)) return n;
+  const glm::dvec3 across = glm::cross(m.anisotropy_b, v);
+  const glm::dvec3 n_a = glm::cross(across, m.anisotropy_b);
+  const double f = 1.0 - m.anisotropy * (1.0 - m.roughness);
+  const double bend = (f * f) * (f * f);
+  const glm::dvec3 bent = n_a * (1.0 - bend) + n * bend;
+  const double bent_length = glm::length(bent);
+  return bent_length > 0.0 ? bent / bent_length : n;
+}
+
 /// The environment's light for the glTF BRDF (core/environment_lighting.hpp), with
 /// F = F0 + (F90 - F0) s:
 ///   occlusion x (c_diff ((1 - F0_d) E / pi - (F90 - F0_d) E_s) + F0 A + (F90 - F0) B),
@@ -80,7 +95,7 @@ glm::dvec3 environment_pbr(const SurfaceShading& s, const PbrPoint& m, const glm
                            const glm::dvec3& v) {
   const EnvironmentLighting* environment = s.context->environment;
   if (environment == nullptr || n == glm::dvec3(0.0)) return glm::dvec3(0.0);
-  const EnvironmentIntegrals e = environment->integrals(n, v, m.roughness);
+  const EnvironmentIntegrals e = environment->integrals(n, v, m.roughness, mirror_normal(m, n, v));
   const glm::dvec3 gap = m.f90 - m.f0;
   const glm::dvec3 diffuse =
       m.f90 == glm::dvec3(1.0) && m.f0_diffuse == m.f0
@@ -235,10 +250,16 @@ glm::dvec3 pbr_shade(const SurfaceShading& s, PbrPoint m, const glm::dvec3& p, c
 //   f = (1 - F_d) c_diff / pi + F D V
 // F_d is F with the dielectric F0 colour reduced to its largest channel (KHR_materials_specular:
 // the diffuse keeps what the strongest channel leaves); without the extension F_d = F.
+// KHR_materials_anisotropy replaces D V by its anisotropic lobe (pbr_terms.hpp,
+// anisotropic_ggx_lobe) with alpha_t = mix(alpha, 1, anisotropy^2) along t, alpha_b = alpha.
 glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l) {
   const double alpha = std::max(m.roughness * m.roughness, kMinBrdfAlpha);
-  const GgxLobe lobe = ggx_lobe(n, v, l, alpha * alpha);
+  const GgxLobe lobe =
+      m.anisotropy > 0.0
+          ? anisotropic_ggx_lobe(n, m.anisotropy_t, m.anisotropy_b, v, l,
+                                 alpha + (1.0 - alpha) * (m.anisotropy * m.anisotropy), alpha)
+          : ggx_lobe(n, v, l, alpha * alpha);
   const double weight = schlick_weight(std::abs(lobe.h_dot_v));
   glm::dvec3 fresnel = m.f0 + (m.f90 - m.f0) * weight;
   glm::dvec3 fresnel_diffuse =
@@ -311,8 +332,21 @@ void PbrPoint::set_iridescence(const SurfaceShading& s, double n_dot_v) {
   iridescent_diffuse = glm::dvec3(strongest) * (1.0 - metallic) + over_metal * metallic;
 }
 
+void PbrPoint::set_anisotropy(double strength, const glm::dvec3& direction, const glm::dvec3& n) {
+  // The stretched direction made orthogonal to the shading normal, so that t, b, n is the
+  // orthonormal frame the anisotropic D assumes (the extension takes T from the interpolated
+  // normal's frame and b = normalize(n_geometric x T); without a normal map they agree).
+  const glm::dvec3 t = direction - n * glm::dot(n, direction);
+  const double t_length = glm::length(t);
+  if (!(t_length > 1e-12)) return;
+  anisotropy = strength;
+  anisotropy_t = t / t_length;
+  anisotropy_b = glm::cross(n, anisotropy_t);
+}
+
 glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
-                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal) {
+                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal,
+                       const glm::dvec3& anisotropy_direction) {
   const ShadingContext& c = *s.context;
   const glm::dvec3 to_eye = c.eye_world - p;
   const double eye_distance = glm::length(to_eye);
@@ -329,8 +363,11 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
              environment_diffuse(c, s.occlusion, base, n) + blinn_phong_highlights(s, p, n, v) +
              s.emissive;
     case LitModel::Pbr:
-    default:
-      return pbr_shade(s, PbrPoint(s, base, clearcoat_normal), p, n, v);
+    default: {
+      PbrPoint m(s, base, clearcoat_normal);
+      if (s.anisotropy > 0.0) m.set_anisotropy(s.anisotropy, anisotropy_direction, n);
+      return pbr_shade(s, m, p, n, v);
+    }
   }
 }
 
@@ -399,8 +436,9 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
   s.sheen_roughness = sample.sheen_roughness;
   s.iridescence = sample.iridescence;
   s.iridescence_thickness_nm = sample.iridescence_thickness_nm;
+  s.anisotropy = sample.anisotropy;
   return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
-                            sample.clearcoat_normal));
+                            sample.clearcoat_normal, sample.anisotropy_direction));
 }
 
 }  // namespace covrast::detail

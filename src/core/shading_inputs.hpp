@@ -69,6 +69,7 @@ struct SurfaceTextures {
   const TextureSlot* sheen_roughness = nullptr;        ///< KHR_materials_sheen, A
   const TextureSlot* iridescence = nullptr;            ///< KHR_materials_iridescence, R
   const TextureSlot* iridescence_thickness = nullptr;  ///< KHR_materials_iridescence, G
+  const TextureSlot* anisotropy = nullptr;  ///< KHR_materials_anisotropy: RG direction, B strength
 };
 
 /// The fragment over which sample_surface averages its textures
@@ -115,6 +116,10 @@ struct SurfaceShading {
   double iridescence_ior = 1.3;
   double iridescence_thickness_nm = 400.0;
   double iridescence_thickness_min_nm = 100.0;
+  /// pbr, KHR_materials_anisotropy: strength (0: none) and (cos, sin) of the rotation from the
+  /// tangent towards the bitangent.
+  double anisotropy = 0.0;
+  glm::dvec2 anisotropy_rotation{1.0, 0.0};
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
@@ -162,6 +167,10 @@ struct SurfaceSample {
   double sheen_roughness = 0.0;  ///< the surface's, times the sheen roughness texture's A
   double iridescence = 0.0;      ///< the surface's, times the iridescence texture's R
   double iridescence_thickness_nm = 400.0;  ///< the maximum, or lerped by the texture's G
+  double anisotropy = 0.0;                  ///< the surface's, times the texture's B
+  /// unit, world space: the direction the anisotropic lobe is stretched along (zero: no
+  /// tangent frame here, the lobe is the isotropic one)
+  glm::dvec3 anisotropy_direction{0.0};
 };
 
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
@@ -196,8 +205,10 @@ WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double 
 /// Outgoing linear radiance at world point `p` with unit normal `n` (zero: no normal) and
 /// base colour `base` (linear): the material's model, summed over the context's lights.
 /// `clearcoat_normal` (unit, or zero) is the pbr clear coat's normal (KHR_materials_clearcoat).
+/// `anisotropy_direction` (unit, or zero: isotropic) is KHR_materials_anisotropy's direction.
 glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base, const glm::dvec3& p,
-                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal);
+                       const glm::dvec3& n, const glm::dvec3& clearcoat_normal,
+                       const glm::dvec3& anisotropy_direction = glm::dvec3(0.0));
 inline glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base,
                               const glm::dvec3& p, const glm::dvec3& n) {
   return shade_point(surface, base, p, n, n);
@@ -229,6 +240,11 @@ struct PbrPoint {
   glm::dvec3 iridescent_dielectric{0.0}, iridescent_metal{0.0};
   glm::dvec3 iridescent{0.0}, iridescent_diffuse{0.0};
   void set_iridescence(const SurfaceShading& s, double n_dot_v);
+  /// KHR_materials_anisotropy (set by set_anisotropy): its strength and the lobe's frame, the
+  /// stretched direction t made orthogonal to n and b = n x t (strength 0: no frame).
+  double anisotropy = 0.0;
+  glm::dvec3 anisotropy_t{0.0}, anisotropy_b{0.0};
+  void set_anisotropy(double strength, const glm::dvec3& direction, const glm::dvec3& n);
 };
 
 /// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-

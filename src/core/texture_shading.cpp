@@ -134,23 +134,71 @@ glm::dvec4 lookup(const TriangleSetup& t, const TextureSlot& slot, const Texture
   return footprint_average(t, slot, at.uv, *footprint, at.p, at.lod);
 }
 
-/// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
-/// frame T (the tangent made orthogonal to n), B = (n x T) w, n; the interpolated normal when
-/// the frame is degenerate (no tangent).
-glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const TexturedCorners& corners,
-                            const double mu[3], const glm::dvec3& n) {
+/// The tangent frame at a point: T, the interpolated tangent made orthogonal to the unit
+/// normal n, and B = (n x T) w; `valid` is false where there is no tangent (zero, or along n).
+struct TangentFrame {
+  glm::dvec3 tangent{0.0}, bitangent{0.0};
+  bool valid = false;
+};
+
+TangentFrame tangent_frame(const TexturedCorners& corners, const double mu[3],
+                           const glm::dvec3& n) {
+  TangentFrame frame;
   glm::dvec3 tangent(0.0);
   for (int k = 0; k < 3; ++k) tangent += mu[k] * glm::dvec3(corners.tangent_world[k]);
   tangent -= n * glm::dot(n, tangent);
   const double tangent_length = glm::length(tangent);
-  if (!(tangent_length > 1e-12)) return n;
-  tangent /= tangent_length;
+  if (!(tangent_length > 1e-12)) return frame;
+  frame.tangent = tangent / tangent_length;
   const double handedness = corners.tangent_world[0].w < 0.0f ? -1.0 : 1.0;
-  const glm::dvec3 bitangent = glm::cross(n, tangent) * handedness;
-  const glm::dvec3 m = tangent * ((2.0 * texel.r - 1.0) * scale) +
-                       bitangent * ((2.0 * texel.g - 1.0) * scale) + n * (2.0 * texel.b - 1.0);
+  frame.bitangent = glm::cross(n, frame.tangent) * handedness;
+  frame.valid = true;
+  return frame;
+}
+
+/// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
+/// frame T, B, n (tangent_frame); the interpolated normal when the frame is degenerate.
+glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const TexturedCorners& corners,
+                            const double mu[3], const glm::dvec3& n) {
+  const TangentFrame frame = tangent_frame(corners, mu, n);
+  if (!frame.valid) return n;
+  const glm::dvec3 m = frame.tangent * ((2.0 * texel.r - 1.0) * scale) +
+                       frame.bitangent * ((2.0 * texel.g - 1.0) * scale) +
+                       n * (2.0 * texel.b - 1.0);
   const double m_length = glm::length(m);
   return m_length > 0.0 ? m / m_length : n;
+}
+
+/// KHR_materials_anisotropy: the direction in the frame T, B of the interpolated normal n,
+///   d = R(rotation) x (1, 0)                      without a texture,
+///   d = R(rotation) x normalize(2 RG - 1)         with one, and strength x its B,
+/// R turning counter-clockwise from T towards B; the world direction is normalize(T d.x +
+/// B d.y). No tangent frame, or a texel direction of zero length: no direction (the lobe is
+/// the isotropic one there).
+void sample_anisotropy(const TriangleSetup& t, const SurfaceShading& s,
+                       const SurfaceTextures& slots, const TexturedCorners& corners,
+                       const double mu[3], const WeightDerivatives& d,
+                       const FragmentFootprint* footprint, const glm::dvec3& normal,
+                       SurfaceSample& out) {
+  if (!(s.anisotropy > 0.0) || normal == glm::dvec3(0.0)) return;
+  glm::dvec2 direction(1.0, 0.0);
+  if (slots.anisotropy != nullptr) {
+    const glm::dvec4 texel = lookup(t, *slots.anisotropy, corners, mu, d, footprint);
+    out.anisotropy *= texel.b;
+    direction = glm::dvec2(2.0 * texel.r - 1.0, 2.0 * texel.g - 1.0);
+    const double length = glm::length(direction);
+    if (!(length > 0.0)) return;
+    direction /= length;
+  }
+  const glm::dvec2 r = s.anisotropy_rotation;
+  direction =
+      glm::dvec2(r.x * direction.x - r.y * direction.y, r.y * direction.x + r.x * direction.y);
+  // The frame of the interpolated normal (as the normal map's), not of the mapped one.
+  const TangentFrame frame = tangent_frame(corners, mu, normal);
+  if (!frame.valid) return;
+  const glm::dvec3 world = frame.tangent * direction.x + frame.bitangent * direction.y;
+  const double world_length = glm::length(world);
+  if (world_length > 0.0) out.anisotropy_direction = world / world_length;
 }
 
 /// The textures of KHR_materials_specular (strength in A, F0 colour in RGB),
@@ -267,6 +315,8 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
                                   slots.normal->scale, corners, mu, normal);
   }
   sample_material_extensions(t, s, slots, corners, mu, d, footprint, out);
+  out.anisotropy = s.anisotropy;
+  sample_anisotropy(t, s, slots, corners, mu, d, footprint, normal, out);
   return out;
 }
 

@@ -60,11 +60,12 @@ SurfaceTextures surface_slots(const Material& m, bool lit) {
   out.sheen_roughness = slot(m.sheen_roughness_texture);
   out.iridescence = slot(m.iridescence_texture);
   out.iridescence_thickness = slot(m.iridescence_thickness_texture);
+  out.anisotropy = slot(m.anisotropy_texture);
   return out;
 }
 
 /// Every slot of `t`, null where the material has none.
-std::array<const TextureSlot*, 14> all_slots(const SurfaceTextures& t) {
+std::array<const TextureSlot*, 15> all_slots(const SurfaceTextures& t) {
   return {t.base_color,
           t.metallic_roughness,
           t.normal,
@@ -78,7 +79,8 @@ std::array<const TextureSlot*, 14> all_slots(const SurfaceTextures& t) {
           t.sheen_color,
           t.sheen_roughness,
           t.iridescence,
-          t.iridescence_thickness};
+          t.iridescence_thickness,
+          t.anisotropy};
 }
 
 bool any_texture(const SurfaceTextures& t) {
@@ -128,6 +130,9 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.iridescence_ior = m.iridescence_ior;
   s.iridescence_thickness_nm = m.iridescence_thickness_max_nm;
   s.iridescence_thickness_min_nm = m.iridescence_thickness_min_nm;
+  s.anisotropy = m.anisotropy;
+  s.anisotropy_rotation =
+      glm::dvec2(std::cos(double(m.anisotropy_rotation)), std::sin(double(m.anisotropy_rotation)));
   return s;
 }
 
@@ -180,7 +185,10 @@ void GeometryFrontEnd::prepare_lighting() {
     for (std::size_t k = 0; k < materials.size(); ++k) {
       SurfaceShading surface = surface_shading(materials[k], &context_);
       if (!scene_.lit) surface.model = LitModel::Unlit;  // textured in a scene without lights
-      if (any_texture(textures_[i][k])) surface.textures = &textures_[i][k];
+      // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
+      // whether or not it has textures.
+      const bool anisotropic = surface.model == LitModel::Pbr && surface.anisotropy > 0.0;
+      if (any_texture(textures_[i][k]) || anisotropic) surface.textures = &textures_[i][k];
       surfaces_[i].push_back(surface);
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;
@@ -242,12 +250,13 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
     }
   }
   for (int k = 0; k < 3; ++k) out[k].tangent_world = glm::vec4(0.0f);
-  // The tangent frame of the normal maps: the normal texture's UV set, else the clearcoat
-  // normal texture's (one frame serves both).
-  const TextureSlot* normal_map = surface.textures->normal != nullptr
-                                      ? surface.textures->normal
-                                      : surface.textures->clearcoat_normal;
-  if (normal_map == nullptr) return;
+  // The tangent frame of the normal maps and of anisotropy (one frame serves them all),
+  // computed from the UV set of the normal texture, else the clearcoat normal texture's, else
+  // the anisotropy texture's, else set 0.
+  const SurfaceTextures& slots = *surface.textures;
+  const TextureSlot* normal_map = slots.normal != nullptr ? slots.normal : slots.clearcoat_normal;
+  const bool anisotropic = surface.model == LitModel::Pbr && surface.anisotropy > 0.0;
+  if (normal_map == nullptr && !anisotropic) return;
   if (!mesh.corner_tangents.empty()) {
     for (int k = 0; k < 3; ++k) {
       const glm::vec4& t = mesh.corner_tangents[local * 3 + std::size_t(k)];
@@ -256,7 +265,9 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
     }
     return;
   }
-  const int set = normal_map->texcoord;
+  const int set = normal_map != nullptr         ? normal_map->texcoord
+                  : slots.anisotropy != nullptr ? slots.anisotropy->texcoord
+                                                : 0;
   const glm::dvec3 e1 = glm::dvec3(out[1].position_world) - glm::dvec3(out[0].position_world);
   const glm::dvec3 e2 = glm::dvec3(out[2].position_world) - glm::dvec3(out[0].position_world);
   const glm::dvec2 d1 = glm::dvec2(out[1].uv[set]) - glm::dvec2(out[0].uv[set]);

@@ -65,7 +65,7 @@ const std::vector<Field> kMaterialExtensionFields = {
     {"KHR_materials_ior", Kind::Object},         {"KHR_materials_specular", Kind::Object},
     {"KHR_materials_clearcoat", Kind::Object},   {"KHR_materials_sheen", Kind::Object},
     {"KHR_materials_iridescence", Kind::Object}, {"KHR_materials_emissive_strength", Kind::Object},
-    {"KHR_materials_unlit", Kind::Object}};
+    {"KHR_materials_unlit", Kind::Object},       {"KHR_materials_anisotropy", Kind::Object}};
 
 /// The top-level arrays whose elements covrast reads, and the fields it reads of each.
 struct Section {

@@ -174,6 +174,16 @@ void read_iridescence(const ExtensionObject& e, const std::string& name, GltfTex
   m.iridescence_thickness_texture = texture(e, "iridescenceThicknessTexture", false, textures);
 }
 
+/// KHR_materials_anisotropy: anisotropyStrength (0..1) and anisotropyRotation (radians, any
+/// finite number), anisotropyTexture (RG direction, B strength; linear).
+void read_anisotropy(const ExtensionObject& e, const std::string& name, GltfTextures& textures,
+                     Material& m) {
+  m.anisotropy = static_cast<float>(number_in(e, "anisotropyStrength", 0.0, 0.0, 1.0, name));
+  m.anisotropy_rotation =
+      static_cast<float>(number_in(e, "anisotropyRotation", 0.0, -1e6, 1e6, name));
+  m.anisotropy_texture = texture(e, "anisotropyTexture", false, textures);
+}
+
 }  // namespace
 
 std::vector<Material> read_materials(const tinygltf::Model& model, GltfTextures& textures,
@@ -220,6 +230,10 @@ void read_material_extensions(const tinygltf::Material& source, int index, GltfT
   if (const ExtensionObject e = find_extension(source, index, kIridescenceExtension, name);
       e.value) {
     read_iridescence(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kAnisotropyExtension, name);
+      e.value) {
+    read_anisotropy(e, name, textures, m);
   }
 }
 

@@ -25,6 +25,7 @@ inline constexpr std::string_view kSpecularExtension = "KHR_materials_specular";
 inline constexpr std::string_view kClearcoatExtension = "KHR_materials_clearcoat";
 inline constexpr std::string_view kSheenExtension = "KHR_materials_sheen";
 inline constexpr std::string_view kIridescenceExtension = "KHR_materials_iridescence";
+inline constexpr std::string_view kAnisotropyExtension = "KHR_materials_anisotropy";
 
 /// The file's materials as covrast shades them, in file order, then glTF's default material
 /// (for primitives without one): each material's factors (glTF 2.0, 3.9 and 5.19), textures

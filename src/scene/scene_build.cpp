@@ -91,6 +91,8 @@ void check_material(const Material& m, const std::string& what) {
   if (!(m.clearcoat_roughness >= 0.0f && m.clearcoat_roughness <= 1.0f)) {
     fail(what, "clearcoat_roughness must be in 0..1");
   }
+  if (!(m.anisotropy >= 0.0f && m.anisotropy <= 1.0f)) fail(what, "anisotropy must be in 0..1");
+  if (!std::isfinite(m.anisotropy_rotation)) fail(what, "anisotropy_rotation must be finite");
   for (const TextureSlot* slot : m.texture_slots()) {
     if (slot->texcoord < 0 || slot->texcoord >= kMaxTexcoordSets) {
       fail(what, "a texture's texcoord must be 0 or 1");

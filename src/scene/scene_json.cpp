@@ -41,6 +41,7 @@ using detail::scene_environment;
 using detail::SceneMeshes;
 using detail::SceneReader;
 using detail::shown;
+using detail::warn_anisotropy_without_tangents;
 using detail::warn_beyond_finite_range;
 
 /// 1-based line and column of byte `offset` (columns count bytes, like nlohmann's).
@@ -308,6 +309,7 @@ Scene load_scene_posed(const std::filesystem::path& json_path, MeshFiles& files,
     Scene scene = scene_from_root(root, file, json_path.parent_path(), files, nullptr);
     scene.source = json_path;
     warn_beyond_finite_range(scene);
+    warn_anisotropy_without_tangents(scene);
     return scene;
   } catch (const json::exception& e) {
     throw InputError(json_path.string() + ": " + exception_detail(e));
@@ -377,6 +379,7 @@ Scene load_mesh_scene(const std::filesystem::path& mesh_path, int width, int hei
   scene.lit = true;
   scene.source = mesh_path;
   warn_beyond_finite_range(scene);
+  warn_anisotropy_without_tangents(scene);
   return scene;
 }
 

@@ -25,7 +25,7 @@ constexpr std::array<std::string_view, 4> kEnvironmentKeys = {"file", "builtin",
                                                               "intensity"};
 constexpr std::array<std::string_view, 7> kMeshKeys = {"obj",      "gltf",    "color",  "model",
                                                        "material", "normals", "variant"};
-constexpr std::array<std::string_view, 20> kMaterialKeys = {"model",
+constexpr std::array<std::string_view, 22> kMaterialKeys = {"model",
                                                             "base_color",
                                                             "metallic",
                                                             "roughness",
@@ -44,7 +44,9 @@ constexpr std::array<std::string_view, 20> kMaterialKeys = {"model",
                                                             "sheen_roughness",
                                                             "iridescence",
                                                             "iridescence_ior",
-                                                            "iridescence_thickness_nm"};
+                                                            "iridescence_thickness_nm",
+                                                            "anisotropy",
+                                                            "anisotropy_rotation_deg"};
 
 /// Levenshtein distance (insertions, deletions, substitutions), one row at a time.
 std::size_t edit_distance(std::string_view a, std::string_view b) {

@@ -3,6 +3,7 @@
 // draws with, the file's with the scene's keys applied.
 #include "scene/scene_reader.hpp"
 
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -18,7 +19,7 @@ ShadingModel SceneReader::shading_model(const json& value, const std::string& pa
 }
 
 /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat,
-/// _sheen, _iridescence).
+/// _sheen, _iridescence, _anisotropy).
 void SceneReader::apply_material_extensions(const json& object, const std::string& key,
                                             Material& m) const {
   if (const auto it = object.find("ior"); it != object.end()) {
@@ -53,6 +54,13 @@ void SceneReader::apply_material_extensions(const json& object, const std::strin
   if (const auto it = object.find("clearcoat_roughness"); it != object.end()) {
     m.clearcoat_roughness =
         static_cast<float>(number_in(*it, key + ".clearcoat_roughness", 0.0, 1.0));
+  }
+  if (const auto it = object.find("anisotropy"); it != object.end()) {
+    m.anisotropy = static_cast<float>(number_in(*it, key + ".anisotropy", 0.0, 1.0));
+  }
+  if (const auto it = object.find("anisotropy_rotation_deg"); it != object.end()) {
+    const double degrees = number_in(*it, key + ".anisotropy_rotation_deg", -360.0, 360.0);
+    m.anisotropy_rotation = static_cast<float>(degrees * (std::numbers::pi / 180.0));
   }
 }
 

@@ -137,6 +137,9 @@ std::vector<Material> instance_materials(const SceneReader& reader, const json& 
 Camera gltf_camera(const std::string& file, const json& object, const FirstGltf& first,
                    const Scene& scene);
 void warn_beyond_finite_range(Scene& scene);
+/// A warning for every lit instance with a KHR_materials_anisotropy material (pbr, strength >
+/// 0) whose mesh has neither tangents nor UVs: no tangent frame, so it is drawn isotropic.
+void warn_anisotropy_without_tangents(Scene& scene);
 std::vector<Light> gltf_lights(const std::string& file, const FirstGltf& gltf);
 EnvironmentLight scene_environment(const std::string& file, const json& value,
                                    const std::filesystem::path& base_dir,
