@@ -116,6 +116,8 @@ struct Mesh {
   std::string description;  ///< written as the OBJ header comment
   std::vector<Vec3> positions;
   std::vector<Vec3> colors;  ///< sRGB per vertex, written as "v x y z r g b"; may be empty
+  /// Per vertex (u, v), written as "vt u v" with faces "f a/a b/b c/c"; may be empty.
+  std::vector<std::array<double, 2>> uvs;
   std::vector<std::array<std::uint32_t, 3>> triangles;  ///< 0-based, counter-clockwise
 
   std::string to_obj() const {
@@ -130,7 +132,15 @@ struct Mesh {
       }
       out += "\n";
     }
-    for (const auto& t : triangles) appendf(out, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+    for (const auto& uv : uvs) out += "vt " + num(uv[0]) + " " + num(uv[1]) + "\n";
+    for (const auto& t : triangles) {
+      if (uvs.empty()) {
+        appendf(out, "f %u %u %u\n", t[0] + 1, t[1] + 1, t[2] + 1);
+      } else {
+        appendf(out, "f %u/%u %u/%u %u/%u\n", t[0] + 1, t[0] + 1, t[1] + 1, t[1] + 1, t[2] + 1,
+                t[2] + 1);
+      }
+    }
     return out;
   }
 };
@@ -172,6 +182,39 @@ Mesh make_uv_sphere(const std::string& file_name, int segments, int rings) {
   }
   for (int j = 0; j < segments; ++j) {
     mesh.triangles.push_back({at(rings - 1, j), south, at(rings - 1, j + 1)});
+  }
+  return mesh;
+}
+
+/// UV sphere of radius 1 with texture coordinates u = phi / (2 pi), v = theta / pi (OBJ's v
+/// upwards: 1 at the north pole): vertex (ring i, column j) for i in 0..rings, j in
+/// 0..segments, so the seam and the poles have a vertex per column (the tangent frames
+/// computed from the UVs need them). Counter-clockwise seen from outside.
+Mesh make_textured_sphere(const std::string& file_name, int segments, int rings) {
+  Mesh mesh;
+  mesh.file_name = file_name;
+  mesh.description = "UV sphere with texture coordinates, radius 1, " + std::to_string(segments) +
+                     " segments x " + std::to_string(rings) +
+                     " rings, a vertex per column at the seam and the poles";
+  for (int i = 0; i <= rings; ++i) {
+    const double theta = kPi * i / rings;
+    for (int j = 0; j <= segments; ++j) {
+      const double phi = 2.0 * kPi * j / segments;
+      mesh.positions.push_back(
+          {std::sin(theta) * std::sin(phi), std::cos(theta), std::sin(theta) * std::cos(phi)});
+      mesh.uvs.push_back({double(j) / segments, 1.0 - double(i) / rings});
+    }
+  }
+  const auto at = [segments](int ring, int column) {
+    return static_cast<std::uint32_t>(ring * (segments + 1) + column);
+  };
+  for (int i = 0; i < rings; ++i) {
+    for (int j = 0; j < segments; ++j) {
+      // (top-left, bottom-left, bottom-right) and (top-left, bottom-right, top-right); at the
+      // poles only the one that is not degenerate.
+      if (i + 1 < rings) mesh.triangles.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      if (i > 0) mesh.triangles.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
   }
   return mesh;
 }
@@ -1134,6 +1177,7 @@ OutputFile obj(const Mesh& mesh) { return OutputFile{mesh.file_name, mesh.to_obj
 std::vector<Entry> all_entries() {
   const Mesh sphere = make_uv_sphere("sphere.obj", 48, 24);
   const Mesh sphere5k = make_uv_sphere("sphere5k.obj", 50, 51);
+  const Mesh sphere_uv = make_textured_sphere("sphere_uv.obj", 48, 24);
   const Mesh fan = make_fan();
   const Mesh box = make_box();
   const Mesh big_tri = make_big_tri();
@@ -1151,6 +1195,7 @@ std::vector<Entry> all_entries() {
       {"overlap.json", fixed({file(make_overlap()), obj(tri)})},
       {"sphere.obj", fixed({obj(sphere)})},
       {"sphere5k.obj", fixed({obj(sphere5k)})},
+      {"sphere_uv.obj", fixed({obj(sphere_uv)})},
       {"fan.obj", fixed({obj(fan)})},
       {"box.obj", fixed({obj(box)})},
       {"big_tri.obj", fixed({obj(big_tri)})},

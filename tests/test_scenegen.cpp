@@ -32,7 +32,7 @@ const fs::path kScenesDir = fs::path(COVRAST_SOURCE_DIR) / "scenes";
 const std::set<std::string> kGeneratedFiles = {
     "default.json",     "sphere_closed.json", "boxes.json", "slivers.json", "near_plane.json",
     "sphere_grid.json", "overlap.json",       "sphere.obj", "sphere5k.obj", "fan.obj",
-    "box.obj",          "big_tri.obj",        "tri.obj"};
+    "box.obj",          "big_tri.obj",        "tri.obj",    "sphere_uv.obj"};
 
 /// A temporary directory of this file's tests.
 class TempDir : public covrast::test::TempDir {
