@@ -30,6 +30,26 @@ inline double smith_g(double n_dot_x, double alpha2) {
   return n_dot_x + std::sqrt(alpha2 + (1.0 - alpha2) * n_dot_x * n_dot_x);
 }
 
+/// What both GGX lobes read of unit n, v, l: h = normalize(l + v) (n when l = -v), |n . l|,
+/// |n . v|, n . h, h . l and h . v; `lit` where the lobe is not 0 (n.h, h.l and h.v > 0).
+struct HalfVector {
+  glm::dvec3 h;
+  double n_dot_l, n_dot_v, n_dot_h, h_dot_l, h_dot_v;
+  bool lit() const { return n_dot_h > 0.0 && h_dot_l > 0.0 && h_dot_v > 0.0; }
+};
+inline HalfVector half_vector(const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l) {
+  const glm::dvec3 h_sum = l + v;
+  const double h_length = glm::length(h_sum);
+  HalfVector out;
+  out.h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
+  out.n_dot_l = std::abs(glm::dot(n, l));
+  out.n_dot_v = std::abs(glm::dot(n, v));
+  out.n_dot_h = glm::dot(n, out.h);
+  out.h_dot_l = glm::dot(out.h, l);
+  out.h_dot_v = glm::dot(out.h, v);
+  return out;
+}
+
 /// The GGX specular lobe of the glTF BRDF for unit n, v, l and alpha^2 (Appendix B.3.5):
 /// D x V in one division, alpha^2 / (pi k^2 g_l g_v) with k = (n.h)^2 (alpha^2 - 1) + 1 (0 where
 /// n.h, h.l or h.v <= 0), and h . v for the Fresnel term; h = normalize(l + v), n when l = -v.
@@ -39,17 +59,13 @@ struct GgxLobe {
 };
 inline GgxLobe ggx_lobe(const glm::dvec3& n, const glm::dvec3& v, const glm::dvec3& l,
                         double alpha2) {
-  const glm::dvec3 h_sum = l + v;
-  const double h_length = glm::length(h_sum);
-  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
-  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
-  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l);
+  const HalfVector hv = half_vector(n, v, l);
   GgxLobe lobe;
-  lobe.h_dot_v = glm::dot(h, v);
-  if (n_dot_h > 0.0 && h_dot_l > 0.0 && lobe.h_dot_v > 0.0) {
-    const double k = n_dot_h * n_dot_h * (alpha2 - 1.0) + 1.0;
-    const double gl = smith_g(n_dot_l, alpha2);
-    const double gv = smith_g(n_dot_v, alpha2);
+  lobe.h_dot_v = hv.h_dot_v;
+  if (hv.lit()) {
+    const double k = hv.n_dot_h * hv.n_dot_h * (alpha2 - 1.0) + 1.0;
+    const double gl = smith_g(hv.n_dot_l, alpha2);
+    const double gv = smith_g(hv.n_dot_v, alpha2);
     lobe.d_vis = alpha2 / (std::numbers::pi * k * k * (gl * gv));
   }
   return lobe;
@@ -66,22 +82,19 @@ inline GgxLobe ggx_lobe(const glm::dvec3& n, const glm::dvec3& v, const glm::dve
 inline GgxLobe anisotropic_ggx_lobe(const glm::dvec3& n, const glm::dvec3& t, const glm::dvec3& b,
                                     const glm::dvec3& v, const glm::dvec3& l, double alpha_t,
                                     double alpha_b) {
-  const glm::dvec3 h_sum = l + v;
-  const double h_length = glm::length(h_sum);
-  const glm::dvec3 h = h_length > 0.0 ? h_sum * (1.0 / h_length) : n;
-  const double n_dot_l = std::abs(glm::dot(n, l)), n_dot_v = std::abs(glm::dot(n, v));
-  const double n_dot_h = glm::dot(n, h), h_dot_l = glm::dot(h, l);
+  const HalfVector hv = half_vector(n, v, l);
   GgxLobe lobe;
-  lobe.h_dot_v = glm::dot(h, v);
-  if (n_dot_h > 0.0 && h_dot_l > 0.0 && lobe.h_dot_v > 0.0) {
+  lobe.h_dot_v = hv.h_dot_v;
+  if (hv.lit()) {
+    const glm::dvec3& h = hv.h;
     const double a = alpha_t * alpha_b;
-    const glm::dvec3 f(alpha_b * glm::dot(t, h), alpha_t * glm::dot(b, h), a * n_dot_h);
+    const glm::dvec3 f(alpha_b * glm::dot(t, h), alpha_t * glm::dot(b, h), a * hv.n_dot_h);
     const double w2 = a / glm::dot(f, f);
     const double d = a * w2 * w2 / std::numbers::pi;
-    const double ggx_v = n_dot_l * glm::length(glm::dvec3(alpha_t * glm::dot(t, v),
-                                                          alpha_b * glm::dot(b, v), n_dot_v));
-    const double ggx_l = n_dot_v * glm::length(glm::dvec3(alpha_t * glm::dot(t, l),
-                                                          alpha_b * glm::dot(b, l), n_dot_l));
+    const glm::dvec3 v_stretched(alpha_t * glm::dot(t, v), alpha_b * glm::dot(b, v), hv.n_dot_v);
+    const glm::dvec3 l_stretched(alpha_t * glm::dot(t, l), alpha_b * glm::dot(b, l), hv.n_dot_l);
+    const double ggx_v = hv.n_dot_l * glm::length(v_stretched);
+    const double ggx_l = hv.n_dot_v * glm::length(l_stretched);
     lobe.d_vis = d * std::min(0.5 / (ggx_v + ggx_l), 1.0);
   }
   return lobe;
