@@ -295,9 +295,20 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
   // built from).
   std::vector<glm::vec3> texels = map.radiance_linear;
   suns_ = take_out_suns(texels, w, h);
+  build_radiance_pyramid(std::move(texels), w, h);
+  build_moment_pyramid();
+  build_irradiance_nodes();
+  build_prefiltered();
+  // The suns in the world frame, and x intensity.
+  for (EnvironmentSun& sun : suns_) {
+    sun.to_light = to_world(sun.to_light);
+    sun.irradiance *= intensity_;
+  }
+}
 
-  // Radiance pyramid: each level halves the previous (rounding up), texels averaged with
-  // their solid angles as weights.
+// Radiance pyramid: each level halves the previous (rounding up), texels averaged with their
+// solid angles as weights.
+void EnvironmentLighting::build_radiance_pyramid(std::vector<glm::vec3> texels, int w, int h) {
   radiance_.push_back({w, h, std::move(texels)});
   while (radiance_.back().width > 1 || radiance_.back().height > 1) {
     const RadianceLevel& fine = radiance_.back();
@@ -322,23 +333,29 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
     }
     radiance_.push_back(std::move(coarse));
   }
+}
 
-  // Moment pyramid: the finest cells group whole texels; every coarser level merges 2 x 2.
+void EnvironmentLighting::set_cell_geometry(MomentCell& cell, double u0, double u1, double v0,
+                                            double v1) {
+  cell.centre = environment_direction(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+  // The farthest point of a latitude-longitude rectangle from its centre is a corner.
+  double min_cos = 1.0;
+  for (double u : {u0, u1}) {
+    for (double v : {v0, v1}) {
+      min_cos = std::min(min_cos, glm::dot(cell.centre, environment_direction(u, v)));
+    }
+  }
+  const double radius = std::acos(std::clamp(min_cos, -1.0, 1.0)) + 1e-9;
+  // Wider than a hemisphere: never wholly above or below a horizon.
+  cell.sin_radius = radius < 0.5 * kPi ? std::sin(radius) : 2.0;
+}
+
+// Moment pyramid, from the radiance pyramid's level 0: the finest cells group whole texels;
+// every coarser level merges 2 x 2.
+void EnvironmentLighting::build_moment_pyramid() {
+  const int w = radiance_[0].width, h = radiance_[0].height;
   const int cells_x = floor_pow2(std::min(w, kMomentCellsAcross));
   const int cells_y = floor_pow2(std::min(h, kMomentCellsAcross / 2));
-  auto cell_geometry = [](MomentCell& cell, double u0, double u1, double v0, double v1) {
-    cell.centre = environment_direction(0.5 * (u0 + u1), 0.5 * (v0 + v1));
-    // The farthest point of a latitude-longitude rectangle from its centre is a corner.
-    double min_cos = 1.0;
-    for (double u : {u0, u1}) {
-      for (double v : {v0, v1}) {
-        min_cos = std::min(min_cos, glm::dot(cell.centre, environment_direction(u, v)));
-      }
-    }
-    const double radius = std::acos(std::clamp(min_cos, -1.0, 1.0)) + 1e-9;
-    // Wider than a hemisphere: never wholly above or below a horizon.
-    cell.sin_radius = radius < 0.5 * kPi ? std::sin(radius) : 2.0;
-  };
   MomentLevel finest{cells_x, cells_y, {}};
   finest.cells.resize(std::size_t(cells_x) * std::size_t(cells_y));
   for (int y = 0; y < h; ++y) {
@@ -354,9 +371,9 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
   }
   for (int cy = 0; cy < cells_y; ++cy) {
     for (int cx = 0; cx < cells_x; ++cx) {
-      cell_geometry(finest.cells[std::size_t(cy) * std::size_t(cells_x) + std::size_t(cx)],
-                    double(cx) / cells_x, double(cx + 1) / cells_x, double(cy) / cells_y,
-                    double(cy + 1) / cells_y);
+      set_cell_geometry(finest.cells[std::size_t(cy) * std::size_t(cells_x) + std::size_t(cx)],
+                        double(cx) / cells_x, double(cx + 1) / cells_x, double(cy) / cells_y,
+                        double(cy + 1) / cells_y);
     }
   }
   moments_.push_back(std::move(finest));
@@ -374,26 +391,23 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
                          std::size_t(2 * cx + k % 2)];
           for (int c = 0; c < 3; ++c) cell.m[std::size_t(c)] += child.m[std::size_t(c)];
         }
-        cell_geometry(cell, double(cx) / coarse.width, double(cx + 1) / coarse.width,
-                      double(cy) / coarse.height, double(cy + 1) / coarse.height);
+        set_cell_geometry(cell, double(cx) / coarse.width, double(cx + 1) / coarse.width,
+                          double(cy) / coarse.height, double(cy + 1) / coarse.height);
       }
     }
     moments_.push_back(std::move(coarse));
   }
-  // The irradiance of the map without its suns at the nodes, by the exact walk; smooth (a
-  // cosine-weighted integral of a map without bright points), so interpolated between them.
+}
+
+// The irradiance of the map without its suns at the nodes, by the exact walk; smooth (a
+// cosine-weighted integral of a map without bright points), so interpolated between them.
+void EnvironmentLighting::build_irradiance_nodes() {
   irradiance_nodes_.reserve(std::size_t(kIrradianceNodesAcross) * kIrradianceNodesDown);
   for (int y = 0; y < kIrradianceNodesDown; ++y) {
     for (int x = 0; x < kIrradianceNodesAcross; ++x) {
       irradiance_nodes_.push_back(walk_irradiance(environment_direction(
           (x + 0.5) / kIrradianceNodesAcross, (y + 0.5) / kIrradianceNodesDown)));
     }
-  }
-  build_prefiltered();
-  // The suns in the world frame, and x intensity.
-  for (EnvironmentSun& sun : suns_) {
-    sun.to_light = to_world(sun.to_light);
-    sun.irradiance *= intensity_;
   }
 }
 

@@ -108,6 +108,10 @@ class EnvironmentLighting {
     double weight;  ///< V(n.l, 1) (n.l)
     double lod;     ///< pyramid level of its share of the sphere
   };
+  void build_radiance_pyramid(std::vector<glm::vec3> texels, int width, int height);
+  static void set_cell_geometry(MomentCell& cell, double u0, double u1, double v0, double v1);
+  void build_moment_pyramid();
+  void build_irradiance_nodes();
   void build_prefiltered();
   std::vector<PrefilterSample> prefilter_lobe(int samples, double alpha2) const;
   glm::dvec3 prefilter_texel(const glm::dvec3& r, const std::vector<PrefilterSample>& lobe) const;
