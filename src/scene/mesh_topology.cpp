@@ -64,12 +64,12 @@ std::uint32_t find_root(std::vector<std::uint32_t>& parent, std::uint32_t x) {
   return root;
 }
 
-/// The orientation (+1, -1, or 0 when not closed) of a mesh whose indices are all in range and
-/// whose referenced positions are finite; `used` marks the referenced vertices.
-int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>& used) {
+/// Step 1 of closed_orientation_of, the weld: each referenced vertex's id among the distinct
+/// referenced positions (sorted by their bits: any total order groups equal ones); returns
+/// the number of distinct positions.
+std::uint32_t weld_positions(const MeshData& mesh, const std::vector<std::uint8_t>& used,
+                             std::vector<std::uint32_t>& weld) {
   const std::size_t vertex_count = mesh.positions.size();
-  const std::size_t triangle_count = mesh.triangle_count();
-  // 1. Weld: sort the referenced positions by their bits (any total order groups equal ones).
   std::vector<WeldKey> keys;
   keys.reserve(vertex_count);
   for (std::size_t v = 0; v < vertex_count; ++v) {
@@ -79,17 +79,24 @@ int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>&
                            std::uint32_t(v)});
   }
   std::sort(keys.begin(), keys.end());
-  std::vector<std::uint32_t> weld(vertex_count, 0);
+  weld.assign(vertex_count, 0);
   std::uint32_t welded_count = 0;
   for (std::size_t k = 0; k < keys.size(); ++k) {
     if (k > 0 && !keys[k].same_position(keys[k - 1])) ++welded_count;
     weld[keys[k].vertex] = welded_count;
   }
-  ++welded_count;
-  keys = {};
-  // 2. Edge uses of the non-degenerate triangles, filed by their lower welded id with a
-  // counting sort (two passes: count, then place), then each (short) bucket sorted.
-  std::vector<std::uint8_t> degenerate(triangle_count, 0);
+  return welded_count + 1;
+}
+
+/// Step 2: the edge uses of the non-degenerate triangles (`degenerate` marks the others),
+/// filed by their lower welded id with a counting sort (two passes: count, then place), then
+/// each (short) bucket sorted; every edge must be used exactly twice, once each way, and
+/// `parent` joins the triangles across each edge (union-find). False when some edge is not.
+bool join_across_edges(const MeshData& mesh, const std::vector<std::uint32_t>& weld,
+                       std::uint32_t welded_count, std::vector<std::uint8_t>& degenerate,
+                       std::vector<std::uint32_t>& parent) {
+  const std::size_t triangle_count = mesh.triangle_count();
+  degenerate.assign(triangle_count, 0);
   std::vector<std::uint32_t> bucket(std::size_t(welded_count) + 1, 0);
   const auto welded = [&](std::size_t t, int k) { return weld[mesh.indices[3 * t + k]]; };
   for (std::size_t t = 0; t < triangle_count; ++t) {
@@ -103,7 +110,7 @@ int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>&
     ++bucket[std::min(w2, w0) + 1];
   }
   for (std::size_t b = 1; b < bucket.size(); ++b) bucket[b] += bucket[b - 1];
-  if (bucket.back() == 0) return 0;
+  if (bucket.back() == 0) return false;
   std::vector<EdgeUse> edges(bucket.back());
   std::vector<std::uint32_t> fill(bucket.begin(), bucket.end() - 1);
   for (std::size_t t = 0; t < triangle_count; ++t) {
@@ -115,7 +122,7 @@ int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>&
     }
   }
   fill = {};
-  std::vector<std::uint32_t> parent(triangle_count);
+  parent.resize(triangle_count);
   std::iota(parent.begin(), parent.end(), 0u);
   for (std::size_t low = 0; low < welded_count; ++low) {
     const auto first = edges.begin() + bucket[low], last = edges.begin() + bucket[low + 1];
@@ -124,17 +131,24 @@ int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>&
     // Sorted, a valid pair is (high, direction 0) then (high, direction 1), and the same high
     // does not follow.
     for (auto e = first; e != last; e += 2) {
-      if (last - e < 2) return 0;  // used once
+      if (last - e < 2) return false;  // used once
       const EdgeUse& a = e[0];
       const EdgeUse& b = e[1];
-      if ((a.high_dir >> 1) != (b.high_dir >> 1)) return 0;                     // used once
-      if ((a.high_dir & 1u) != 0 || (b.high_dir & 1u) != 1) return 0;           // twice one way
-      if (last - e > 2 && (e[2].high_dir >> 1) == (a.high_dir >> 1)) return 0;  // > twice
+      if ((a.high_dir >> 1) != (b.high_dir >> 1)) return false;                     // used once
+      if ((a.high_dir & 1u) != 0 || (b.high_dir & 1u) != 1) return false;           // twice one way
+      if (last - e > 2 && (e[2].high_dir >> 1) == (a.high_dir >> 1)) return false;  // > twice
       const std::uint32_t ra = find_root(parent, a.triangle), rb = find_root(parent, b.triangle);
       if (ra != rb) parent[std::max(ra, rb)] = std::min(ra, rb);
     }
   }
-  // 3. Signed volume per component, relative to the first vertex of its root triangle.
+  return true;
+}
+
+/// Step 3: the signed volume of each component `parent` joins, relative to the first vertex
+/// of its root triangle; their common sign, or 0 when one is too flat or two disagree.
+int components_orientation(const MeshData& mesh, const std::vector<std::uint8_t>& degenerate,
+                           std::vector<std::uint32_t>& parent) {
+  const std::size_t triangle_count = mesh.triangle_count();
   std::vector<std::uint32_t> component(triangle_count, std::numeric_limits<std::uint32_t>::max());
   std::vector<double> volume, magnitude;
   for (std::size_t t = 0; t < triangle_count; ++t) {
@@ -162,6 +176,18 @@ int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>&
     sign = s;
   }
   return sign;
+}
+
+/// The orientation (+1, -1, or 0 when not closed) of a mesh whose indices are all in range and
+/// whose referenced positions are finite; `used` marks the referenced vertices.
+int closed_orientation_of(const MeshData& mesh, const std::vector<std::uint8_t>& used) {
+  std::vector<std::uint32_t> weld;
+  const std::uint32_t welded_count = weld_positions(mesh, used, weld);
+  std::vector<std::uint8_t> degenerate;
+  std::vector<std::uint32_t> parent;
+  if (!join_across_edges(mesh, weld, welded_count, degenerate, parent)) return 0;
+  weld = {};
+  return components_orientation(mesh, degenerate, parent);
 }
 
 /// Whether a closed mesh of orientation `orientation` is convex: for every non-degenerate face,
