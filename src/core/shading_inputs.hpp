@@ -126,8 +126,11 @@ struct SurfaceShading {
   double base_alpha = 1.0;    ///< the base colour factor's alpha
   const ShadingContext* context = nullptr;
   /// The textures this surface samples; null for an untextured one (no per-pixel texture
-  /// work at all), and for an Unlit one without a base colour texture.
+  /// work at all), and for an Unlit one without a base colour texture. An anisotropic surface
+  /// has them, for the tangent frame its triangles then carry, even when no slot is set.
   const SurfaceTextures* textures = nullptr;
+  /// Some slot of `textures` is set: what coverage mode averages over a fragment.
+  bool has_texture_slots = false;
 };
 
 /// What a textured triangle adds to its ShadingRecord, in the TriangleSetup's vertex order:

@@ -188,7 +188,8 @@ void GeometryFrontEnd::prepare_lighting() {
       // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
       // whether or not it has textures.
       const bool anisotropic = surface.model == LitModel::Pbr && surface.anisotropy > 0.0;
-      if (any_texture(textures_[i][k]) || anisotropic) surface.textures = &textures_[i][k];
+      surface.has_texture_slots = any_texture(textures_[i][k]);
+      if (surface.has_texture_slots || anisotropic) surface.textures = &textures_[i][k];
       surfaces_[i].push_back(surface);
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;

@@ -60,7 +60,7 @@ ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y);
 
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
 inline glm::vec3 shade_fragment(const TriangleSetup& t, int x, int y) {
-  if (t.shading != nullptr && t.shading->textured != nullptr) {
+  if (t.shading != nullptr && t.shading->surface->has_texture_slots) {
     return shade_fragment_averaged(t, x, y);
   }
   return shade(t, x + 0.5, y + 0.5, true);
