@@ -120,6 +120,7 @@ struct SurfaceShading {
   /// tangent towards the bitangent.
   double anisotropy = 0.0;
   glm::dvec2 anisotropy_rotation{1.0, 0.0};
+  bool anisotropic() const { return model == LitModel::Pbr && anisotropy > 0.0; }
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff

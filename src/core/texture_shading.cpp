@@ -157,10 +157,9 @@ TangentFrame tangent_frame(const TexturedCorners& corners, const double mu[3],
 }
 
 /// glTF 2.0, 3.9.3 normalTexture: n_ts = normalize((2 rgb - 1) x (scale, scale, 1)) in the
-/// frame T, B, n (tangent_frame); the interpolated normal when the frame is degenerate.
-glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const TexturedCorners& corners,
-                            const double mu[3], const glm::dvec3& n) {
-  const TangentFrame frame = tangent_frame(corners, mu, n);
+/// frame T, B, n (`frame`, tangent_frame of n); n when the frame is degenerate.
+glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const TangentFrame& frame,
+                            const glm::dvec3& n) {
   if (!frame.valid) return n;
   const glm::dvec3 m = frame.tangent * ((2.0 * texel.r - 1.0) * scale) +
                        frame.bitangent * ((2.0 * texel.g - 1.0) * scale) +
@@ -169,7 +168,7 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
   return m_length > 0.0 ? m / m_length : n;
 }
 
-/// KHR_materials_anisotropy: the direction in the frame T, B of the interpolated normal n,
+/// KHR_materials_anisotropy: the direction in `frame`, T, B of the interpolated normal,
 ///   d = R(rotation) x (1, 0)                      without a texture,
 ///   d = R(rotation) x normalize(2 RG - 1)         with one, and strength x its B,
 /// R turning counter-clockwise from T towards B; the world direction is normalize(T d.x +
@@ -178,9 +177,9 @@ glm::dvec3 perturbed_normal(const glm::dvec4& texel, double scale, const Texture
 void sample_anisotropy(const TriangleSetup& t, const SurfaceShading& s,
                        const SurfaceTextures& slots, const TexturedCorners& corners,
                        const double mu[3], const WeightDerivatives& d,
-                       const FragmentFootprint* footprint, const glm::dvec3& normal,
+                       const FragmentFootprint* footprint, const TangentFrame& frame,
                        SurfaceSample& out) {
-  if (!(s.anisotropy > 0.0) || normal == glm::dvec3(0.0)) return;
+  if (!s.anisotropic() || !frame.valid) return;
   glm::dvec2 direction(1.0, 0.0);
   if (slots.anisotropy != nullptr) {
     const glm::dvec4 texel = lookup(t, *slots.anisotropy, corners, mu, d, footprint);
@@ -193,9 +192,6 @@ void sample_anisotropy(const TriangleSetup& t, const SurfaceShading& s,
   const glm::dvec2 r = s.anisotropy_rotation;
   direction =
       glm::dvec2(r.x * direction.x - r.y * direction.y, r.y * direction.x + r.x * direction.y);
-  // The frame of the interpolated normal (as the normal map's), not of the mapped one.
-  const TangentFrame frame = tangent_frame(corners, mu, normal);
-  if (!frame.valid) return;
   const glm::dvec3 world = frame.tangent * direction.x + frame.bitangent * direction.y;
   const double world_length = glm::length(world);
   if (world_length > 0.0) out.anisotropy_direction = world / world_length;
@@ -209,7 +205,8 @@ void sample_anisotropy(const TriangleSetup& t, const SurfaceShading& s,
 void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
                                 const SurfaceTextures& slots, const TexturedCorners& corners,
                                 const double mu[3], const WeightDerivatives& d,
-                                const FragmentFootprint* footprint, SurfaceSample& out) {
+                                const FragmentFootprint* footprint, const TangentFrame& frame,
+                                SurfaceSample& out) {
   if (slots.specular != nullptr)
     out.specular_weight *= lookup(t, *slots.specular, corners, mu, d, footprint).a;
   if (slots.specular_color != nullptr) {
@@ -237,7 +234,7 @@ void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
   if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
     out.clearcoat_normal =
         perturbed_normal(lookup(t, *slots.clearcoat_normal, corners, mu, d, footprint),
-                         slots.clearcoat_normal->scale, corners, mu, out.clearcoat_normal);
+                         slots.clearcoat_normal->scale, frame, out.clearcoat_normal);
   }
 }
 
@@ -291,8 +288,15 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.sheen_roughness = s.sheen_roughness;
   out.iridescence = s.iridescence;
   out.iridescence_thickness_nm = s.iridescence_thickness_nm;
+  out.anisotropy = s.anisotropy;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
+  // One tangent frame per point, of the interpolated normal: the normal map's, the clearcoat
+  // normal map's (which perturbs the interpolated normal too) and anisotropy's.
+  const bool needs_frame =
+      normal != glm::dvec3(0.0) &&
+      (slots.normal != nullptr || slots.clearcoat_normal != nullptr || s.anisotropic());
+  const TangentFrame frame = needs_frame ? tangent_frame(corners, mu, normal) : TangentFrame{};
   if (slots.base_color != nullptr) {
     out.base_color = footprint != nullptr && footprint->has_base_color
                          ? footprint->base_color
@@ -312,11 +316,10 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   }
   if (slots.normal != nullptr && normal != glm::dvec3(0.0)) {
     out.normal = perturbed_normal(lookup(t, *slots.normal, corners, mu, d, footprint),
-                                  slots.normal->scale, corners, mu, normal);
+                                  slots.normal->scale, frame, normal);
   }
-  sample_material_extensions(t, s, slots, corners, mu, d, footprint, out);
-  out.anisotropy = s.anisotropy;
-  sample_anisotropy(t, s, slots, corners, mu, d, footprint, normal, out);
+  sample_material_extensions(t, s, slots, corners, mu, d, footprint, frame, out);
+  sample_anisotropy(t, s, slots, corners, mu, d, footprint, frame, out);
   return out;
 }
 

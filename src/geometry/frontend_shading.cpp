@@ -187,9 +187,8 @@ void GeometryFrontEnd::prepare_lighting() {
       if (!scene_.lit) surface.model = LitModel::Unlit;  // textured in a scene without lights
       // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
       // whether or not it has textures.
-      const bool anisotropic = surface.model == LitModel::Pbr && surface.anisotropy > 0.0;
       surface.has_texture_slots = any_texture(textures_[i][k]);
-      if (surface.has_texture_slots || anisotropic) surface.textures = &textures_[i][k];
+      if (surface.has_texture_slots || surface.anisotropic()) surface.textures = &textures_[i][k];
       surfaces_[i].push_back(surface);
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;
@@ -256,8 +255,7 @@ void GeometryFrontEnd::texture_vertices(const MeshInstance& inst, std::size_t lo
   // the anisotropy texture's, else set 0.
   const SurfaceTextures& slots = *surface.textures;
   const TextureSlot* normal_map = slots.normal != nullptr ? slots.normal : slots.clearcoat_normal;
-  const bool anisotropic = surface.model == LitModel::Pbr && surface.anisotropy > 0.0;
-  if (normal_map == nullptr && !anisotropic) return;
+  if (normal_map == nullptr && !surface.anisotropic()) return;
   if (!mesh.corner_tangents.empty()) {
     for (int k = 0; k < 3; ++k) {
       const glm::vec4& t = mesh.corner_tangents[local * 3 + std::size_t(k)];

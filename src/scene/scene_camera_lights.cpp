@@ -263,24 +263,6 @@ void warn_beyond_finite_range(Scene& scene) {
   }
 }
 
-void warn_anisotropy_without_tangents(Scene& scene) {
-  if (!scene.lit) return;
-  for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
-    const MeshInstance& instance = scene.meshes[i];
-    const MeshData& mesh = *instance.mesh;
-    bool has_uvs = false;
-    for (const auto& set : mesh.corner_texcoords) has_uvs = has_uvs || !set.empty();
-    if (!mesh.corner_tangents.empty() || has_uvs) continue;
-    for (const Material& m : instance.materials) {
-      if (m.model != ShadingModel::Pbr || !(m.anisotropy > 0.0f)) continue;
-      scene.warnings.push_back(scene.source.string() + ": meshes[" + std::to_string(i) +
-                               "]: anisotropy needs a tangent frame (tangents, or UVs to "
-                               "compute them from) and the mesh has none: drawn isotropic");
-      break;
-    }
-  }
-}
-
 /// "lights": "gltf": the KHR_lights_punctual lights of every glTF mesh entry, in entry order
 /// and each file's walk order, placed at the light's node's world transform times the
 /// entry's model matrix; the light shines down the node's -z. Checked as add_light checks.
