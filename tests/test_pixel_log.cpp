@@ -153,6 +153,68 @@ TEST_CASE("pixel log: a tiling proves a layer, which hides what lies behind it",
   CHECK(log.state(0) == LogState::Off);
 }
 
+TEST_CASE("pixel log: a mixed pixel proves a later layer from a run, which hides what is behind",
+          "[coverage][log]") {
+  const std::vector<TriangleSetup> front = fan_over_pixel(5), layer = fan_over_pixel(6, true);
+  const std::uint32_t half = std::uint32_t(kCoverageOne) / 2,
+                      sixth = std::uint32_t(kCoverageOne) / 6;
+  const auto append_layer = [&](PixelLog& log, double depth) {
+    for (int k = 0; k < 6; ++k) {
+      const std::uint32_t c = k < 5 ? sixth : std::uint32_t(kCoverageOne) - 5 * sixth;
+      log.append(0, 10, 10, layer[std::size_t(k)], c, depth + 0.01 * k, 0.002);
+    }
+  };
+  // The farthest depth the layer's pieces reach, as the log computes it.
+  const auto far_of_layer = [](double depth) { return depth + 0.01 * 5 + 0.002; };
+  PixelLog log(1);
+  log.clear_entries();
+  log.start_pixel(0, true);
+  // Two halves of a fan reach the pixel without a zero key sum: mixed, nothing proven.
+  for (int k = 0; k < 2; ++k) log.append(0, 10, 10, front[std::size_t(k)], half, 0.2, 0.001);
+  REQUIRE(log.state(0) == LogState::Mixed);
+  CHECK(std::isinf(log.hidden_from(0)));
+  // A layer further back tiles the pixel: its farthest depth hides what follows.
+  append_layer(log, 0.6);
+  CHECK(log.state(0) == LogState::Mixed);
+  CHECK(log.hidden_from(0) == far_of_layer(0.6));
+  // A nearer layer lowers the bound; a farther one leaves it.
+  append_layer(log, 0.9);
+  CHECK(log.hidden_from(0) == far_of_layer(0.6));
+  append_layer(log, 0.4);
+  CHECK(log.hidden_from(0) == far_of_layer(0.4));
+
+  // A run that reaches the pixel without a proof starts again from its last fragment, which
+  // here begins a layer: the bound is the layer's alone, not the stray piece's (depth 0.95).
+  log.start_pixel(0, true);
+  for (int k = 0; k < 2; ++k) log.append(0, 10, 10, front[std::size_t(k)], half, 0.2, 0.001);
+  log.append(0, 10, 10, front[3], std::uint32_t(kCoverageOne) - 10, 0.95, 0.001);
+  CHECK(std::isinf(log.hidden_from(0)));
+  append_layer(log, 0.6);
+  CHECK(log.hidden_from(0) == far_of_layer(0.6));
+
+  // Pieces that overlap (the same piece twice) prove nothing, however far they go.
+  log.start_pixel(0, true);
+  for (int k = 0; k < 2; ++k) log.append(0, 10, 10, front[std::size_t(k)], half, 0.2, 0.001);
+  for (int k = 0; k < 8; ++k) log.append(0, 10, 10, layer[0], half, 0.6, 0.002);
+  CHECK(std::isinf(log.hidden_from(0)));
+  // Pieces of one facing of a convex surface never overlap: reaching the pixel, they prove a
+  // layer without the keys (these two halves alone would not).
+  log.start_pixel(0, true);
+  for (int k = 0; k < 2; ++k) log.append(0, 10, 10, front[std::size_t(k)], half, 0.2, 0.001);
+  TriangleSetup convex[2] = {front[2], front[3]};
+  for (TriangleSetup& t : convex) t.convex_surface = true, t.surface = 3, t.front_facing = true;
+  log.append(0, 10, 10, convex[0], half, 0.7, 0.002);
+  log.append(0, 10, 10, convex[1], half, 0.7, 0.002);
+  CHECK(log.hidden_from(0) == 0.7 + 0.002);
+  // And a proven first layer with a fragment in front: the run starts at that fragment.
+  log.start_pixel(0, true);
+  append_layer(log, 0.6);
+  REQUIRE(log.state(0) == LogState::Proven);
+  append_layer(log, 0.3);
+  CHECK(log.state(0) == LogState::Mixed);
+  CHECK(log.hidden_from(0) == far_of_layer(0.3));
+}
+
 TEST_CASE("pixel log: proven layers give the list's bytes, and every path is taken",
           "[coverage][log]") {
   // Two spheres whose triangles are near pixel size. The left one is analysed: convex, its

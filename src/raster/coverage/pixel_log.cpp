@@ -118,7 +118,10 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   tail_[pixel] = index;
   count_[pixel] = std::uint8_t(n + 1);
   if (state_[pixel] != LogState::Open) {
-    state_[pixel] = LogState::Mixed;  // after a proven layer: something in front of it
+    // After a proven layer: something in front of it. The sums start again for a nearer one.
+    if (state_[pixel] == LogState::Proven) restart_sums(pixel);
+    state_[pixel] = LogState::Mixed;
+    prove_later_layer(pixel, x, y, t, coverage, centre_z + reach);
     return;
   }
   coverage_sum_[pixel] += coverage;
@@ -146,7 +149,37 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
     hidden_from_[pixel] = far_[pixel];
   } else {
     state_[pixel] = LogState::Mixed;
+    restart_sums(pixel);
   }
+}
+
+void PixelLog::restart_sums(std::size_t pixel) {
+  coverage_sum_[pixel] = 0;
+  key_sum_[pixel] = 0;
+  far_[pixel] = -INFINITY;
+}
+
+void PixelLog::prove_later_layer(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                                 std::uint32_t coverage, double far) {
+  const std::uint64_t key = crossing_key(t, coverage, x, y);
+  const bool first = coverage_sum_[pixel] == 0;
+  if (first || convex_[pixel] != convex_key(t)) convex_[pixel] = first ? convex_key(t) : kNotConvex;
+  coverage_sum_[pixel] += coverage;
+  key_sum_[pixel] += key;
+  far_[pixel] = std::max(far_[pixel], far);
+  if (coverage_sum_[pixel] < std::uint32_t(kCoverageOne)) return;
+  if (convex_[pixel] != kNotConvex ||
+      (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2)) {
+    // The run since the last restart tiles the pixel: nothing behind its farthest depth shows.
+    hidden_from_[pixel] = std::min(hidden_from_[pixel], far_[pixel]);
+    restart_sums(pixel);
+    return;
+  }
+  // No proof: the next run starts with this fragment, which may begin a layer.
+  convex_[pixel] = convex_key(t);
+  coverage_sum_[pixel] = coverage;
+  key_sum_[pixel] = key;
+  far_[pixel] = far;
 }
 
 PixelLog::LayerColor PixelLog::layer_color(std::size_t pixel, int x, int y) const {

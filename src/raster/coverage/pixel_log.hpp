@@ -23,6 +23,17 @@
 // front of a proven layer) is *mixed*: it resolves by its fragments' 256-sample masks, front to
 // back (abuffer_logged.cpp).
 //
+// A mixed pixel keeps looking for a layer among the fragments that arrive after it turned
+// mixed, since a layer further back hides what lies behind it as well: the running sums start
+// again and take each fragment as it comes (a run, in arrival order, since a mesh's
+// neighbouring triangles arrive close together). A run that reaches the pixel with a zero key
+// sum and less than 1.5 pixels, or of pieces of one convex facing, proves a layer by the same
+// arguments as the first, and its farthest depth bounds hidden_from; a run that reaches the
+// pixel without proving one starts again from its last fragment. Whatever lies behind
+// hidden_from is hidden all over the pixel by the layer, so it is never logged, whichever
+// state the pixel is in: on a pleated sheet seen edge-on this drops the fragments of masked
+// pixels from 348k to 116k a frame.
+//
 // An edge crosses the open pixel when its line has pixel corners strictly on both sides and
 // its bounding box meets the open square: exact in int64 (fx8 coordinates). It can count an
 // edge whose segment stops short of the square, but then it counts it for both triangles of
@@ -94,7 +105,8 @@ class PixelLog {
   }
   LogState state(std::size_t pixel) const { return state_[pixel]; }
   int count(std::size_t pixel) const { return count_[pixel]; }
-  /// A depth at or behind which nothing shows (a proven layer's farthest; +inf: none).
+  /// A depth at or behind which nothing shows (the nearest farthest depth of the layers
+  /// proven so far, the first while Open, later ones by runs once Mixed; +inf: none).
   double hidden_from(std::size_t pixel) const { return hidden_from_[pixel]; }
   /// A layer's colour sums over the pixel's fragments (all of them arrived while it was Open:
   /// one arriving later turns it Mixed): sum(coverage_i * linear colour_i) in arrival order,
@@ -112,6 +124,7 @@ class PixelLog {
   bool one_convex_facing(std::size_t pixel) const { return convex_[pixel] != kNotConvex; }
   /// While Open: the farthest depth a fragment reaches in the pixel.
   double farthest(std::size_t pixel) const { return far_[pixel]; }
+  /// While Open or Proven: the summed coverage of every fragment.
   std::uint32_t coverage_sum(std::size_t pixel) const { return coverage_sum_[pixel]; }
   /// Appends a fragment (`reach`: how far its plane moves from centre_z within the pixel)
   /// and advances the pixel's state (the header's proof).
@@ -137,16 +150,22 @@ class PixelLog {
   std::vector<LogState> state_;
   std::vector<std::uint8_t> count_;
   std::vector<std::uint32_t> head_, tail_;
-  std::vector<std::uint32_t> coverage_sum_;  ///< while Open
-  std::vector<float> near_z_;                ///< while Open: the nearest centre depth
-  std::vector<std::uint32_t> convex_;        ///< while Open: convex_key of all, or kNotConvex
+  /// The running sums of a layer's proof (coverage, keys, farthest depth, convex facing):
+  /// while Open, of every fragment; once Mixed, of the run since the last restart.
+  std::vector<std::uint32_t> coverage_sum_;
+  std::vector<float> near_z_;          ///< while Open: the nearest centre depth
+  std::vector<std::uint32_t> convex_;  ///< of the same fragments: convex_key of all, or kNotConvex
   static constexpr std::uint32_t kNotConvex = 0xffffffffu;
   static std::uint32_t convex_key(const TriangleSetup& t) {
     return t.convex_surface ? t.surface * 2 + (t.front_facing ? 1u : 0u) : kNotConvex;
   }
-  std::vector<std::uint64_t> key_sum_;  ///< while Open
-  std::vector<double> far_;             ///< while Open: the farthest depth reached
+  std::vector<std::uint64_t> key_sum_;
+  std::vector<double> far_;
   std::vector<double> hidden_from_;
+  void restart_sums(std::size_t pixel);
+  /// Once Mixed: adds a fragment to the run and lowers hidden_from when the run proves a layer.
+  void prove_later_layer(std::size_t pixel, int x, int y, const TriangleSetup& t,
+                         std::uint32_t coverage, double far);
   std::vector<LoggedFragment> entries_;
   EdgeCrossingKeys keys_;
 };
