@@ -130,6 +130,105 @@ HWY_INLINE VI Channel(VU bytes, int ch) {
   return hn::BitCast(di, hn::And(shifted, hn::Set(du, 0xFFu)));
 }
 
+/// Step 4 for a vector of candidates: the search along the edge, both ways, for its ends,
+/// with bilinear samples half a pixel across it (`side` -1: towards n or w), and the blend
+/// weight that the nearer end gives, at least `subpix`.
+HWY_INLINE VF EdgeEndWeight(const FxaaFrame& f, const FxaaParams& p, VI xs, VI ys, MF valid,
+                            MF horizontal, VF side, VF m, VF edge_mean, VF gradient, VF subpix) {
+  const DF df;
+  const DI di;
+  const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), half = hn::Set(df, 0.5f);
+  const VI izero = hn::Zero(di), ione = hn::Set(di, 1);
+  const VI wmax = hn::Set(di, f.width - 1), hmax = hn::Set(di, f.height - 1);
+  const VI width = hn::Set(di, f.width);
+  const VF xf = hn::ConvertTo(df, xs);
+  const VF yf = hn::ConvertTo(df, ys);
+  const VF half_side = hn::Mul(half, side);
+  const VF u_across = hn::Add(xf, half_side), v_across = hn::Add(yf, half_side);
+  // The luma `along` the edge from the pixel, less the edge's mean.
+  const auto sample = [&](VF along) HWY_ATTR {
+    const VF u = hn::IfThenElse(horizontal, hn::Add(xf, along), u_across);
+    const VF v = hn::IfThenElse(horizontal, v_across, hn::Add(yf, along));
+    const VF x0 = hn::Floor(u), y0 = hn::Floor(v);
+    const VF fx = hn::Sub(u, x0), fy = hn::Sub(v, y0);
+    const VI ix = hn::ConvertTo(di, x0), iy = hn::ConvertTo(di, y0);
+    const VI col0 = Clamp(ix, izero, wmax), col1 = Clamp(hn::Add(ix, ione), izero, wmax);
+    const VI row0 = hn::Mul(Clamp(iy, izero, hmax), width);
+    const VI row1 = hn::Mul(Clamp(hn::Add(iy, ione), izero, hmax), width);
+    const VF top =
+        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row0, col0))),
+                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row0, col1))));
+    const VF bottom =
+        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row1, col0))),
+                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row1, col1))));
+    return hn::Sub(hn::Add(hn::Mul(hn::Sub(one, fy), top), hn::Mul(fy, bottom)), edge_mean);
+  };
+  const VF limit = hn::Mul(hn::Set(df, 0.25f), gradient);
+  VF back_distance = hn::Set(df, p.steps[0]), ahead_distance = back_distance;
+  VF back_luma = sample(hn::Neg(back_distance)), ahead_luma = sample(ahead_distance);
+  MF back_on = valid, ahead_on = valid;
+  for (int k = 1; k < p.step_count; ++k) {
+    back_on = hn::AndNot(hn::Ge(hn::Abs(back_luma), limit), back_on);
+    ahead_on = hn::AndNot(hn::Ge(hn::Abs(ahead_luma), limit), ahead_on);
+    if (hn::AllFalse(df, hn::Or(back_on, ahead_on))) break;
+    const VF step = hn::Set(df, p.steps[k]);
+    back_distance = hn::IfThenElse(back_on, hn::Add(back_distance, step), back_distance);
+    ahead_distance = hn::IfThenElse(ahead_on, hn::Add(ahead_distance, step), ahead_distance);
+    if (k + 1 < p.step_count) {
+      back_luma = hn::IfThenElse(back_on, sample(hn::Neg(back_distance)), back_luma);
+      ahead_luma = hn::IfThenElse(ahead_on, sample(ahead_distance), ahead_luma);
+    }
+  }
+  // The nearer end decides: 0.5 - distance / span where the span is good.
+  const MF centre_below = hn::Lt(hn::Sub(m, edge_mean), zero);
+  const MF back_nearer = hn::Lt(back_distance, ahead_distance);
+  const VF nearer_distance = hn::IfThenElse(back_nearer, back_distance, ahead_distance);
+  const VF nearer_luma = hn::IfThenElse(back_nearer, back_luma, ahead_luma);
+  const MF good_span = hn::Xor(hn::Lt(nearer_luma, zero), centre_below);
+  const VF span_offset =
+      hn::Sub(half, hn::Div(nearer_distance, hn::Add(back_distance, ahead_distance)));
+  return StdMax(hn::IfThenElseZero(good_span, span_offset), subpix);
+}
+
+/// Step 5 for the lanes in `blend`: each pixel mixed with its partner across the edge (one
+/// step towards n or w where `to_before`, else s or e; clamped to the frame) by `weight`, in
+/// linear light, and written into `out` as 8-bit sRGB.
+HWY_INLINE void WriteBlends(const FxaaFrame& f, VI xs, VI ys, MF horizontal, MF to_before,
+                            VF weight, MF blend, const Srgb8EncodeTables& tables,
+                            std::uint8_t* HWY_RESTRICT out) {
+  const DF df;
+  const DI di;
+  const VI izero = hn::Zero(di), ione = hn::Set(di, 1);
+  const VI wmax = hn::Set(di, f.width - 1), hmax = hn::Set(di, f.height - 1);
+  const VI width = hn::Set(di, f.width);
+  const VI step = hn::IfThenElse(hn::RebindMask(di, to_before), hn::Set(di, -1), ione);
+  const VI horizontal_i = hn::VecFromMask(di, hn::RebindMask(di, horizontal));
+  const VI ox = Clamp(hn::Add(xs, hn::AndNot(horizontal_i, step)), izero, wmax);
+  const VI oy = Clamp(hn::Add(ys, hn::And(horizontal_i, step)), izero, hmax);
+  const VI pixel = hn::Add(hn::Mul(ys, width), xs);
+  const VU centre = PixelBytes(f, pixel);
+  const VU other = PixelBytes(f, hn::Add(hn::Mul(oy, width), ox));
+  const float* linear = fxaa_srgb8_linear();
+  const VF keep = hn::Sub(hn::Set(df, 1.0f), weight);
+  HWY_ALIGN std::int32_t code[3][kMaxLanes];
+  for (int ch = 0; ch < 3; ++ch) {
+    const VF a = hn::GatherIndex(df, linear, Channel(centre, ch));
+    const VF b = hn::GatherIndex(df, linear, Channel(other, ch));
+    hn::Store(EncodeSrgb8(hn::Add(hn::Mul(keep, a), hn::Mul(weight, b)), tables), di, code[ch]);
+  }
+  const int lanes = int(hn::Lanes(df));
+  HWY_ALIGN std::int32_t pixel_of[kMaxLanes], write[kMaxLanes];
+  hn::Store(pixel, di, pixel_of);
+  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, blend)), di, write);
+  for (int i = 0; i < lanes; ++i) {
+    if (write[i] == 0) continue;
+    std::uint8_t* dst = out + 3 * std::size_t(pixel_of[i]);
+    dst[0] = std::uint8_t(code[0][i]);
+    dst[1] = std::uint8_t(code[1][i]);
+    dst[2] = std::uint8_t(code[2][i]);
+  }
+}
+
 /// Steps 2 to 5 for the candidates (xs, ys) (valid lanes: `valid`; the others hold pixel
 /// (0, 0)); `out` is the output frame.
 HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, VI xs, VI ys, MF valid,
@@ -189,84 +288,11 @@ HWY_INLINE void BlendCandidates(const FxaaFrame& f, const FxaaParams& p, VI xs, 
   const VF side = hn::IfThenElse(to_before, hn::Set(df, -1.0f), one);
   const VF edge_mean = hn::Mul(half, hn::Add(hn::IfThenElse(to_before, before, after), m));
 
-  // Step 4: bilinear samples half a pixel across the edge, `along` it from the pixel.
-  const VF xf = hn::ConvertTo(df, xs);
-  const VF yf = hn::ConvertTo(df, ys);
-  const VF half_side = hn::Mul(half, side);
-  const VF u_across = hn::Add(xf, half_side), v_across = hn::Add(yf, half_side);
-  const auto sample = [&](VF along) HWY_ATTR {
-    const VF u = hn::IfThenElse(horizontal, hn::Add(xf, along), u_across);
-    const VF v = hn::IfThenElse(horizontal, v_across, hn::Add(yf, along));
-    const VF x0 = hn::Floor(u), y0 = hn::Floor(v);
-    const VF fx = hn::Sub(u, x0), fy = hn::Sub(v, y0);
-    const VI ix = hn::ConvertTo(di, x0), iy = hn::ConvertTo(di, y0);
-    const VI col0 = Clamp(ix, izero, wmax), col1 = Clamp(hn::Add(ix, ione), izero, wmax);
-    const VI row0 = hn::Mul(Clamp(iy, izero, hmax), width);
-    const VI row1 = hn::Mul(Clamp(hn::Add(iy, ione), izero, hmax), width);
-    const VF top =
-        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row0, col0))),
-                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row0, col1))));
-    const VF bottom =
-        hn::Add(hn::Mul(hn::Sub(one, fx), hn::GatherIndex(df, f.luma, hn::Add(row1, col0))),
-                hn::Mul(fx, hn::GatherIndex(df, f.luma, hn::Add(row1, col1))));
-    return hn::Sub(hn::Add(hn::Mul(hn::Sub(one, fy), top), hn::Mul(fy, bottom)), edge_mean);
-  };
-  const VF limit = hn::Mul(hn::Set(df, 0.25f), gradient);
-  VF back_distance = hn::Set(df, p.steps[0]), ahead_distance = back_distance;
-  VF back_luma = sample(hn::Neg(back_distance)), ahead_luma = sample(ahead_distance);
-  MF back_on = valid, ahead_on = valid;
-  for (int k = 1; k < p.step_count; ++k) {
-    back_on = hn::AndNot(hn::Ge(hn::Abs(back_luma), limit), back_on);
-    ahead_on = hn::AndNot(hn::Ge(hn::Abs(ahead_luma), limit), ahead_on);
-    if (hn::AllFalse(df, hn::Or(back_on, ahead_on))) break;
-    const VF step = hn::Set(df, p.steps[k]);
-    back_distance = hn::IfThenElse(back_on, hn::Add(back_distance, step), back_distance);
-    ahead_distance = hn::IfThenElse(ahead_on, hn::Add(ahead_distance, step), ahead_distance);
-    if (k + 1 < p.step_count) {
-      back_luma = hn::IfThenElse(back_on, sample(hn::Neg(back_distance)), back_luma);
-      ahead_luma = hn::IfThenElse(ahead_on, sample(ahead_distance), ahead_luma);
-    }
-  }
-
-  // The nearer end decides: 0.5 - distance / span where the span is good.
-  const MF centre_below = hn::Lt(hn::Sub(m, edge_mean), zero);
-  const MF back_nearer = hn::Lt(back_distance, ahead_distance);
-  const VF nearer_distance = hn::IfThenElse(back_nearer, back_distance, ahead_distance);
-  const VF nearer_luma = hn::IfThenElse(back_nearer, back_luma, ahead_luma);
-  const MF good_span = hn::Xor(hn::Lt(nearer_luma, zero), centre_below);
-  const VF span_offset =
-      hn::Sub(half, hn::Div(nearer_distance, hn::Add(back_distance, ahead_distance)));
-  const VF weight = StdMax(hn::IfThenElseZero(good_span, span_offset), subpix);
+  const VF weight =
+      EdgeEndWeight(f, p, xs, ys, valid, horizontal, side, m, edge_mean, gradient, subpix);
   const MF blend = hn::And(valid, hn::Ne(weight, zero));
   if (hn::AllFalse(df, blend)) return;
-
-  // Step 5: the partner across the edge, clamped to the frame.
-  const VI step = hn::IfThenElse(hn::RebindMask(di, to_before), hn::Set(di, -1), ione);
-  const VI horizontal_i = hn::VecFromMask(di, hn::RebindMask(di, horizontal));
-  const VI ox = Clamp(hn::Add(xs, hn::AndNot(horizontal_i, step)), izero, wmax);
-  const VI oy = Clamp(hn::Add(ys, hn::And(horizontal_i, step)), izero, hmax);
-  const VI pixel = hn::Add(row, xs);
-  const VU centre = PixelBytes(f, pixel);
-  const VU other = PixelBytes(f, hn::Add(hn::Mul(oy, width), ox));
-  const float* linear = fxaa_srgb8_linear();
-  const VF keep = hn::Sub(one, weight);
-  HWY_ALIGN std::int32_t code[3][kMaxLanes];
-  for (int ch = 0; ch < 3; ++ch) {
-    const VF a = hn::GatherIndex(df, linear, Channel(centre, ch));
-    const VF b = hn::GatherIndex(df, linear, Channel(other, ch));
-    hn::Store(EncodeSrgb8(hn::Add(hn::Mul(keep, a), hn::Mul(weight, b)), tables), di, code[ch]);
-  }
-  const int lanes = int(hn::Lanes(df));
-  HWY_ALIGN std::int32_t pixel_of[kMaxLanes], write[kMaxLanes];
-  hn::Store(pixel, di, pixel_of);
-  hn::Store(hn::VecFromMask(di, hn::RebindMask(di, blend)), di, write);
-  for (int i = 0; i < lanes; ++i) {
-    if (write[i] == 0) continue;
-    std::uint8_t* dst = out + 3 * std::size_t(pixel_of[i]);
-    dst[0] = std::uint8_t(code[0][i]);
-    dst[1] = std::uint8_t(code[1][i]);
-    dst[2] = std::uint8_t(code[2][i]);
-  }
+  WriteBlends(f, xs, ys, horizontal, to_before, weight, blend, tables, out);
 }
 
 void FilterRows(const FxaaFrame& f, const FxaaParams& p, int y_begin, int y_end,

@@ -306,10 +306,30 @@ class ABufferTile {
   /// opaque part of a pixel behind transparent fragments (null: the opaque resolve as is).
   glm::vec3 resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background, float& depth,
                           const Transmittance* tr = nullptr);
+  /// resolve_pixel's parts (abuffer_resolve.cpp): the list's fragments that the opaque
+  /// surface does not hide (their nearest centre depth lowers `depth`); their colour when
+  /// their exact areas add; whether the front layer's do; their colour from visible weights.
+  struct ListFragments;
+  void gather_list(std::size_t pixel, int x, int y, ListFragments& l, float& depth) const;
+  static glm::vec3 list_layer_color(const ListFragments& l, const bool* member, glm::vec3 behind,
+                                    float depth, const Transmittance* tr, int x, int y);
+  static bool front_layer_alone(const ListFragments& l, bool* in_front);
+  static glm::vec3 list_weighted_color(const ListFragments& l, const double* weight,
+                                       glm::vec3 behind, const Transmittance* tr, int x, int y);
   /// A pixel with transparent fragments: the opaque resolve seen through them plus their own
   /// weighted colours (abuffer_transparency.cpp).
   glm::vec3 resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,
                                 float& depth);
+  /// resolve_transparent's parts (abuffer_transparency.cpp): each transparent fragment's
+  /// shown share (S_j, summed) and each opaque contributor's keep_o from the 256 samples
+  /// (`z_opaque`, `id`: the nearest opaque surface at each); S_j of the fragments that own no
+  /// sample, at one point inside them.
+  struct Clear;
+  static void transmittance_by_samples(std::vector<Clear>& clear, int x, int y,
+                                       const double* z_opaque, const TriangleSetup* const* id,
+                                       Transmittance& tr);
+  void sliver_transmittance(std::size_t pixel, int x, int y, std::vector<Clear>& clear,
+                            const Transmittance& tr) const;
   /// The common case of resolve_transparent: every transparent fragment covers the pixel,
   /// lies in front of every opaque contributor all over it, and no two of them cross there.
   /// Then `transmit` = prod (1 - alpha_j) and `light` = sum_j alpha_j c_j prod_{i < j} (1 -

@@ -156,43 +156,40 @@ glm::vec3 ABufferTile::front_layer_color(const LayerSums& sums, glm::vec3 behind
                    float(sums.rgb[2] / denominator + rest * behind.b));
 }
 
-glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
-                                     float& depth, const Transmittance* tr) {
-  const double cx = x + 0.5, cy = y + 0.5;
-  const TriangleSetup* opaque = opaque_[pixel];
-  glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
-  // Seen through transparent fragments: each opaque contributor times what they leave of it.
-  if (tr != nullptr) behind *= float(tr->of(opaque));
-  const auto keep = [tr](const TriangleSetup* t) { return tr != nullptr ? tr->of(t) : 1.0; };
-  // The path this pixel takes, counted for the opaque resolve (a transparent pixel is
-  // counted once, by resolve()).
-  const auto took = [&](std::uint64_t CoverageResolvePaths::*path) {
-    if (tr == nullptr) ++(paths_.*path);
-  };
-  if (head_[pixel] == kEnd) {
-    took(&CoverageResolvePaths::opaque);
-    return behind;
-  }
-
-  const DepthRange opaque_range =
-      opaque != nullptr ? depth_range(*opaque, x, y) : DepthRange{kFar, kFar};
+/// The fragments of a pixel's list that the opaque surface does not hide (resolve_pixel).
+struct ABufferTile::ListFragments {
+  int n = 0;
+  bool crossing = false;  ///< some fragment's plane crosses the opaque one in this pixel
   const TriangleSetup* tri[kMaxFragmentsPerPixel];
   std::uint32_t cov[kMaxFragmentsPerPixel];
   DepthRange range[kMaxFragmentsPerPixel];
-  const MergedPiece* merged[kMaxFragmentsPerPixel];  // null unless it stands for several
+  const MergedPiece* merged[kMaxFragmentsPerPixel];  ///< null unless it stands for several
   FragmentPieces pieces[kMaxFragmentsPerPixel];
-  int n = 0;
-  bool crossing = false;  // some fragment's plane crosses the opaque one in this pixel
+
+  glm::vec3 color(int i, int x, int y) const {
+    return merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
+  }
+  /// What the transparent fragments in front leave of fragment i (1: none, `tr` null).
+  double kept(const Transmittance* tr, int i) const { return tr != nullptr ? tr->of(tri[i]) : 1.0; }
+};
+
+void ABufferTile::gather_list(std::size_t pixel, int x, int y, ListFragments& l,
+                              float& depth) const {
+  const double cx = x + 0.5, cy = y + 0.5;
+  const TriangleSetup* opaque = opaque_[pixel];
+  const DepthRange opaque_range =
+      opaque != nullptr ? depth_range(*opaque, x, y) : DepthRange{kFar, kFar};
   for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
     const TriangleSetup* t = pool_[f].triangle;
     const double centre_z = t->depth_at(cx, cy);
-    pieces[n].count = fragment_pieces(f, pieces[n].piece);
+    const int n = l.n;
+    l.pieces[n].count = fragment_pieces(f, l.pieces[n].piece);
     // A merged fragment spans its pieces' planes: its range is their union, and it is
     // behind the opaque surface only where every piece is.
     DepthRange r{kFar, -kFar};
     bool behind_opaque = opaque != nullptr, crosses_opaque = false;
-    for (int k = 0; k < pieces[n].count; ++k) {
-      const TriangleSetup& p = *pieces[n].piece[k];
+    for (int k = 0; k < l.pieces[n].count; ++k) {
+      const TriangleSetup& p = *l.pieces[n].piece[k];
       const DepthRange pr =
           &p == t ? range_around(p, centre_z) : range_around(p, p.depth_at(cx, cy));
       r = {std::min(r.min, pr.min), std::max(r.max, pr.max)};
@@ -204,94 +201,123 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
       crosses_opaque = crosses_opaque || order == DepthOrder::Crossing;
     }
     if (behind_opaque) continue;  // hidden: the opaque surface came later
-    crossing = crossing || crosses_opaque;
-    tri[n] = t;
+    l.crossing = l.crossing || crosses_opaque;
+    l.tri[n] = t;
     const std::uint32_t c = pool_[f].coverage;
-    cov[n] = c & kCoverageBits;
-    merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
-    range[n] = r;
+    l.cov[n] = c & kCoverageBits;
+    l.merged[n] = (c & kMergedFlag) ? &merged_piece(f) : nullptr;
+    l.range[n] = r;
     depth = std::min(depth, float(centre_z));
-    ++n;
+    ++l.n;
   }
-  if (n == 0) {
-    took(&CoverageResolvePaths::opaque);  // every fragment lies behind the opaque surface
-    return behind;
-  }
+}
 
-  const bool sums_allowed = !testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed);
-  // Pairwise disjoint fragments in front of the opaque surface: their exact areas add (what
-  // the open set's sums give; resolve() takes those directly where it can).
-  auto layer_color = [&](const bool* member) {
-    LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
-    for (int i = 0; i < n; ++i) {
-      if (member != nullptr && !member[i]) continue;
-      const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
-      const double w = double(cov[i]) * keep(tri[i]);
-      sums.coverage += cov[i];
-      sums.rgb[0] += w * c.r;
-      sums.rgb[1] += w * c.g;
-      sums.rgb[2] += w * c.b;
-    }
-    return front_layer_color(sums, behind);
-  };
-  if (sums_allowed && !crossing && pieces_disjoint(n, pieces, nullptr)) {
-    took(&CoverageResolvePaths::disjoint);
-    return layer_color(nullptr);
+glm::vec3 ABufferTile::list_layer_color(const ListFragments& l, const bool* member,
+                                        glm::vec3 behind, float depth, const Transmittance* tr,
+                                        int x, int y) {
+  // Pairwise disjoint fragments (those with `member`, all when null) in front of what is
+  // behind: their exact areas add, as the open set's sums add them.
+  LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
+  for (int i = 0; i < l.n; ++i) {
+    if (member != nullptr && !member[i]) continue;
+    const glm::vec3 c = l.color(i, x, y);
+    const double w = double(l.cov[i]) * l.kept(tr, i);
+    sums.coverage += l.cov[i];
+    sums.rgb[0] += w * c.r;
+    sums.rgb[1] += w * c.g;
+    sums.rgb[2] += w * c.b;
   }
+  return front_layer_color(sums, behind);
+}
 
-  // The front layer: the fragment nearest at its nearest point and every fragment
-  // connected to it (same mesh instance and facing, through shared vertices; a merged
-  // fragment already stands for adjacent pieces of its surface). When its pieces provably
-  // do not overlap and it lies wholly in front of everything else, its exact areas add, and
-  // when they fill the pixel nothing behind shows.
+bool ABufferTile::front_layer_alone(const ListFragments& l, bool* in_front) {
+  // The front layer: the fragment nearest at its nearest point and every fragment connected
+  // to it (same mesh instance and facing, through shared vertices; a merged fragment already
+  // stands for adjacent pieces of its surface). When its pieces provably do not overlap and
+  // it lies wholly in front of everything else, its exact areas add, and when they fill the
+  // pixel nothing behind shows.
   auto connected = [&](int i, int j) {
-    return layer_neighbours(*tri[i], merged[i] != nullptr, range[i], *tri[j], merged[j] != nullptr,
-                            range[j]);
+    return layer_neighbours(*l.tri[i], l.merged[i] != nullptr, l.range[i], *l.tri[j],
+                            l.merged[j] != nullptr, l.range[j]);
   };
-  bool in_front[kMaxFragmentsPerPixel];
-  const FrontLayer front = find_front_layer(n, range, cov, nullptr, connected, in_front);
-  bool front_separate = !crossing;
-  for (int j = 0; j < n && front_separate; ++j) {
-    if (!in_front[j] && !(front.max_depth < range[j].min)) front_separate = false;
+  const FrontLayer front = find_front_layer(l.n, l.range, l.cov, nullptr, connected, in_front);
+  if (l.crossing) return false;
+  for (int j = 0; j < l.n; ++j) {
+    if (!in_front[j] && !(front.max_depth < l.range[j].min)) return false;
   }
-  if (sums_allowed && front_separate &&
-      (front.members == n || front.coverage >= std::uint32_t(kCoverageOne)) &&
-      pieces_disjoint(n, pieces, in_front)) {
-    took(&CoverageResolvePaths::front_layer);
-    return layer_color(in_front);
-  }
-  double weight[kMaxFragmentsPerPixel];
-  // One triangle crossing the opaque plane inside the pixel (where two surfaces
-  // interpenetrate): its visible part is exact by polygon clipping, no masks needed.
-  const double share =
-      n == 1 && crossing && merged[0] == nullptr ? visible_share(*tri[0], *opaque, x, y) : -1.0;
-  if (share >= 0.0) {
-    took(&CoverageResolvePaths::clipped);
-    weight[0] = double(cov[0]) / kCoverageOne * share;
-  } else {
-    took(&CoverageResolvePaths::samples);
-    bool estimated[kMaxFragmentsPerPixel];
-    const int behind_samples = sample_weights(x, y, opaque, n, tri, cov, merged, weight, estimated);
-    fill_estimated_share(n, cov, estimated, double(behind_samples) / kMaskSamples, weight);
-  }
+  return (front.members == l.n || front.coverage >= std::uint32_t(kCoverageOne)) &&
+         pieces_disjoint(l.n, l.pieces, in_front);
+}
+
+glm::vec3 ABufferTile::list_weighted_color(const ListFragments& l, const double* weight,
+                                           glm::vec3 behind, const Transmittance* tr, int x,
+                                           int y) {
+  // colour = sum_i w_i c_i + (1 - sum_i w_i) behind, the weights normalised when they exceed
+  // the pixel.
   double total = 0;
-  for (int i = 0; i < n; ++i) {
-    COVRAST_CHECK(weight[i] >= 0.0 && weight[i] <= double(cov[i]) / kCoverageOne * (1.0 + 1e-9),
+  for (int i = 0; i < l.n; ++i) {
+    COVRAST_CHECK(weight[i] >= 0.0 && weight[i] <= double(l.cov[i]) / kCoverageOne * (1.0 + 1e-9),
                   "a fragment's visible weight lies between 0 and its exact area");
     total += weight[i];
   }
   const double scale = total > 1.0 ? 1.0 / total : 1.0;
   const double rest = total > 1.0 ? 0.0 : 1.0 - total;
   double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < l.n; ++i) {
     if (weight[i] == 0) continue;
-    const glm::vec3 c = merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
-    double w = weight[i] * scale * keep(tri[i]);
+    const glm::vec3 c = l.color(i, x, y);
+    double w = weight[i] * scale * l.kept(tr, i);
     r += w * c.r;
     g += w * c.g;
     b += w * c.b;
   }
   return glm::vec3(float(r), float(g), float(b));
+}
+
+glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
+                                     float& depth, const Transmittance* tr) {
+  const TriangleSetup* opaque = opaque_[pixel];
+  glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
+  // Seen through transparent fragments: each opaque contributor times what they leave of it.
+  if (tr != nullptr) behind *= float(tr->of(opaque));
+  // The path this pixel takes, counted for the opaque resolve (a transparent pixel is
+  // counted once, by resolve()).
+  const auto took = [&](std::uint64_t CoverageResolvePaths::*path) {
+    if (tr == nullptr) ++(paths_.*path);
+  };
+  ListFragments l;
+  if (head_[pixel] != kEnd) gather_list(pixel, x, y, l, depth);
+  if (l.n == 0) {
+    took(&CoverageResolvePaths::opaque);  // no list, or it lies behind the opaque surface
+    return behind;
+  }
+  const bool sums_allowed = !testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed);
+  if (sums_allowed && !l.crossing && pieces_disjoint(l.n, l.pieces, nullptr)) {
+    took(&CoverageResolvePaths::disjoint);
+    return list_layer_color(l, nullptr, behind, depth, tr, x, y);
+  }
+  bool in_front[kMaxFragmentsPerPixel];
+  if (sums_allowed && front_layer_alone(l, in_front)) {
+    took(&CoverageResolvePaths::front_layer);
+    return list_layer_color(l, in_front, behind, depth, tr, x, y);
+  }
+  double weight[kMaxFragmentsPerPixel];
+  // One triangle crossing the opaque plane inside the pixel (where two surfaces
+  // interpenetrate): its visible part is exact by polygon clipping, no masks needed.
+  const double share = l.n == 1 && l.crossing && l.merged[0] == nullptr
+                           ? visible_share(*l.tri[0], *opaque, x, y)
+                           : -1.0;
+  if (share >= 0.0) {
+    took(&CoverageResolvePaths::clipped);
+    weight[0] = double(l.cov[0]) / kCoverageOne * share;
+  } else {
+    took(&CoverageResolvePaths::samples);
+    bool estimated[kMaxFragmentsPerPixel];
+    const int behind_samples =
+        sample_weights(x, y, opaque, l.n, l.tri, l.cov, l.merged, weight, estimated);
+    fill_estimated_share(l.n, l.cov, estimated, double(behind_samples) / kMaskSamples, weight);
+  }
+  return list_weighted_color(l, weight, behind, tr, x, y);
 }
 
 void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,

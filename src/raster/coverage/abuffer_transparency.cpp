@@ -27,10 +27,9 @@
 #include <limits>
 
 namespace covrast::detail {
-namespace {
 
 /// One transparent fragment of the pixel being resolved.
-struct Clear {
+struct ABufferTile::Clear {
   const TriangleSetup* t;
   double area;   ///< exact coverage [pixels]
   double alpha;  ///< at the shading point
@@ -39,6 +38,8 @@ struct Clear {
   int owned;         ///< samples in mask
   double shown = 0;  ///< sum over its samples of V T (then the mean S)
 };
+
+namespace {
 
 /// a before b in depth order: nearer, or level and drawn earlier.
 bool nearer(double za, const TriangleSetup& a, double zb, const TriangleSetup& b) {
@@ -151,38 +152,13 @@ glm::vec3 ABufferTile::opaque_through(std::size_t pixel, int x, int y, glm::vec3
   return (o != nullptr ? shade_fragment(*o, x, y) : background) * float(tr.of(o));
 }
 
-glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,
-                                           float& depth) {
-  Transmittance tr;
-  double transmit;
-  glm::dvec3 light;
-  if (!testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed) &&
-      uniform_transparency(pixel, x, y, transmit, light)) {
-    // Interior of transparent surfaces in front of everything opaque: one transmittance for
-    // the whole pixel (the general formula with S_j and keep_o constant).
-    tr.fallback = transmit;
-    const glm::vec3 behind = opaque_through(pixel, x, y, background, depth, tr);
-    return glm::vec3(float(light.r + behind.r), float(light.g + behind.g),
-                     float(light.b + behind.b));
-  }
-  double z_opaque[kMaskSamples];
-  const TriangleSetup* id[kMaskSamples];
-  opaque_samples(pixel, x, y, z_opaque, id);
-
-  thread_local std::vector<Clear> clear;
-  clear.clear();
-  for (std::uint32_t f = transparent_head_[pixel]; f != kEnd; f = transparent_pool_[f].next) {
-    const TriangleSetup* t = transparent_pool_[f].triangle;
-    const ShadedColor c = shade_fragment_rgba(*t, x, y);
-    const SampleMask mask = pixel_sample_mask(*t, x, y);
-    clear.push_back(Clear{t, double(transparent_pool_[f].coverage) / kCoverageOne,
-                          std::clamp(c.alpha, 0.0, 1.0), c.rgb, mask, mask.count()});
-  }
+void ABufferTile::transmittance_by_samples(std::vector<Clear>& clear, int x, int y,
+                                           const double* z_opaque, const TriangleSetup* const* id,
+                                           Transmittance& tr) {
   const int n = int(clear.size());
   thread_local std::vector<SamplePlane> plane;
   plane.clear();
   for (const Clear& c : clear) plane.emplace_back(*c.t, x, y);
-
   // Per sample: the transparent fragments in front of the opaque surface, nearest first.
   double sum_t[kMaskSamples + 1], total_t = 0.0;
   int count[kMaskSamples + 1];
@@ -215,9 +191,13 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
   }
   for (int s = 0; s < tr.n; ++s) tr.keep[s] = sum_t[s] / count[s];
   tr.fallback = total_t / kMaskSamples;
+}
 
-  // Slivers without a sample: V T at one point inside their part of the pixel, against the
-  // opaque contributors that own samples (and the opaque surface) containing it.
+void ABufferTile::sliver_transmittance(std::size_t pixel, int x, int y, std::vector<Clear>& clear,
+                                       const Transmittance& tr) const {
+  // V T at one point inside the sliver's part of the pixel, against the opaque contributors
+  // that own samples (and the opaque surface) containing it.
+  const int n = int(clear.size());
   for (int j = 0; j < n; ++j) {
     Clear& c = clear[j];
     if (c.owned > 0) continue;
@@ -242,7 +222,36 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
     c.shown = visible ? t : 0.0;
     c.owned = 1;
   }
+}
 
+glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,
+                                           float& depth) {
+  Transmittance tr;
+  double transmit;
+  glm::dvec3 light;
+  if (!testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed) &&
+      uniform_transparency(pixel, x, y, transmit, light)) {
+    // Interior of transparent surfaces in front of everything opaque: one transmittance for
+    // the whole pixel (the general formula with S_j and keep_o constant).
+    tr.fallback = transmit;
+    const glm::vec3 behind = opaque_through(pixel, x, y, background, depth, tr);
+    return glm::vec3(float(light.r + behind.r), float(light.g + behind.g),
+                     float(light.b + behind.b));
+  }
+  double z_opaque[kMaskSamples];
+  const TriangleSetup* id[kMaskSamples];
+  opaque_samples(pixel, x, y, z_opaque, id);
+  thread_local std::vector<Clear> clear;
+  clear.clear();
+  for (std::uint32_t f = transparent_head_[pixel]; f != kEnd; f = transparent_pool_[f].next) {
+    const TriangleSetup* t = transparent_pool_[f].triangle;
+    const ShadedColor c = shade_fragment_rgba(*t, x, y);
+    const SampleMask mask = pixel_sample_mask(*t, x, y);
+    clear.push_back(Clear{t, double(transparent_pool_[f].coverage) / kCoverageOne,
+                          std::clamp(c.alpha, 0.0, 1.0), c.rgb, mask, mask.count()});
+  }
+  transmittance_by_samples(clear, x, y, z_opaque, id, tr);
+  sliver_transmittance(pixel, x, y, clear, tr);  // the fragments without a sample
   // The opaque part seen through the transparent fragments, then their own light.
   const glm::vec3 opaque_part = opaque_through(pixel, x, y, background, depth, tr);
   double r = opaque_part.r, g = opaque_part.g, b = opaque_part.b;
