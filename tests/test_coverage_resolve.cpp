@@ -1174,6 +1174,44 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
   CHECK(fast_blocks > slow_blocks + 10000);
 }
 
+TEST_CASE("coverage: small triangles hidden in every pixel they touch skip the kernel: same bytes",
+          "[coverage]") {
+  // Dense spheres whose back faces are drawn (not analysed): the second pokes through the
+  // first and is drawn after it, so that most of its triangles, and the first one's back
+  // faces that come after its front faces, land where a proven layer or a nearer opaque plane
+  // hides them, and others just in front of or behind the first one's surface do not.
+  Scene s = make_scene(160, 96, from_codes(15, 31, 100));
+  const double placements[3][4] = {
+      {0.0, 0.0, 0.5, 1.6}, {0.6, 0.3, 0.0, 1.3}, {2.0, 0.5, -0.5, 1.0}};
+  for (const auto& p : placements) {
+    add_instance(s, uv_sphere(40, 80), glm::vec3(1), ColorSource::PerTriangle);
+    s.meshes.back().model = glm::dmat4(glm::dvec4(p[3], 0, 0, 0), glm::dvec4(0, p[3], 0, 0),
+                                       glm::dvec4(0, 0, p[3], 0), glm::dvec4(p[0], p[1], p[2], 1));
+  }
+  for (int tile : {16, 64}) {
+    INFO("tile " << tile);
+    RenderOptions o;
+    o.mode.kind = ModeKind::Coverage;
+    o.tile = tile;
+    o.threads = 2;
+    o.want_depth = true;
+    const auto fast = covrast::render(s, o);
+    const auto slow = [&] {
+      // Every triangle drawn pixel by pixel: the skip is off with the other fast paths.
+      const covrast::test::ScopedHook pixels_only(
+          covrast::detail::testing::coverage_hooks.pixel_path_only, true);
+      return covrast::render(s, o);
+    }();
+    INFO("hidden bin entries " << fast.stats.hidden_bin_entries << " of "
+                               << fast.stats.bin_entries);
+    CHECK(fast.stats.hidden_bin_entries > fast.stats.bin_entries / 5);
+    CHECK(slow.stats.hidden_bin_entries == 0);
+    REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
+    CHECK(fast.color.rgb == slow.color.rgb);
+    CHECK(fast.depth.depth == slow.depth.depth);
+  }
+}
+
 TEST_CASE("coverage resolve: one-layer pixels resolve from their sums as from their lists",
           "[coverage]") {
   Scene s = default_like_scene();

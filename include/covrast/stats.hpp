@@ -69,6 +69,9 @@ struct RenderStats {
   std::uint64_t triangles_clipped = 0;          ///< that needed clipping against a plane
   std::uint64_t triangles_setup = 0;            ///< screen triangles that reached binning
   std::uint64_t bin_entries = 0;                ///< (triangle, tile) pairs
+  /// Coverage mode: bin entries of small opaque triangles skipped before the area kernel,
+  /// every pixel they touch being one that would drop their fragment as hidden.
+  std::uint64_t hidden_bin_entries = 0;
   std::uint64_t fragment_overflows = 0;  ///< coverage mode: fragments merged on list overflow
   CoverageResolvePaths resolve_paths;    ///< coverage mode: pixels per resolve path
   /// Tile-local scratch the per-thread rasterizers hold after the frame: the sum over threads

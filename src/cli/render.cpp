@@ -60,7 +60,8 @@ nlohmann::ordered_json stats_json(const RenderOptions& options, const RenderResu
                     {"backface_culled", s.triangles_backface_culled},
                     {"clipped", s.triangles_clipped},
                     {"setup", s.triangles_setup},
-                    {"bin_entries", s.bin_entries}};
+                    {"bin_entries", s.bin_entries},
+                    {"hidden_bin_entries", s.hidden_bin_entries}};
   j["fragment_overflows"] = s.fragment_overflows;
   // Pixels per A-buffer resolve path (coverage mode; docs/coverage.md), of the last frame.
   nlohmann::ordered_json& paths = j["resolve_paths"] = nlohmann::ordered_json::object();

@@ -35,6 +35,9 @@ class TileRasterizer {
   virtual std::size_t scratch_bytes() const = 0;
   /// Fragments merged or dropped because a pixel's list was full (coverage mode).
   virtual std::uint64_t overflow_count() const { return 0; }
+  /// Triangles drawn into a tile and skipped as hidden there, before the kernel (coverage
+  /// mode; counted over the instance's life, as overflow_count).
+  virtual std::uint64_t hidden_draw_count() const { return 0; }
   /// Pixels per resolve path since the last call (coverage mode; zeros otherwise), and
   /// starts counting again.
   virtual CoverageResolvePaths take_resolve_paths() { return {}; }

@@ -143,9 +143,12 @@ struct Renderer::Impl {
 
   /// The frame's image, all zeros, and its depth (1 = far) when the options ask for it.
   RenderResult blank_result() const;
-  /// Zeroes the per-frame counters; returns the rasterizers' overflow count so far (it runs
-  /// over the Renderer's life).
-  std::uint64_t begin_frame_counters();
+  /// The rasterizers' counters that run over the Renderer's life.
+  struct LifeCounters {
+    std::uint64_t overflows = 0, hidden_draws = 0;
+  };
+  /// Zeroes the per-frame counters; returns the life counters so far.
+  LifeCounters begin_frame_counters();
   /// Setup, part 1: vertices to clip space, in fixed blocks per instance; part 2: clip,
   /// snap and set up each chunk of triangles.
   void set_up_triangles();
@@ -161,7 +164,7 @@ struct Renderer::Impl {
     Clock::time_point setup, binning, raster, post, end;
   };
   /// The counters and stage times of a frame.
-  void fill_stats(RenderStats& st, std::uint64_t overflows_before, const StageTimes& t) const;
+  void fill_stats(RenderStats& st, const LifeCounters& before, const StageTimes& t) const;
 };
 
 RenderResult Renderer::Impl::blank_result() const {
@@ -177,15 +180,16 @@ RenderResult Renderer::Impl::blank_result() const {
   return result;
 }
 
-std::uint64_t Renderer::Impl::begin_frame_counters() {
+Renderer::Impl::LifeCounters Renderer::Impl::begin_frame_counters() {
   for (auto& c : setup_counters) c = {};
-  std::uint64_t overflows_before = 0;
+  LifeCounters before;
   for (const auto& r : rasterizers) {
-    overflows_before += r->overflow_count();
+    before.overflows += r->overflow_count();
+    before.hidden_draws += r->hidden_draw_count();
     r->take_resolve_paths();  // what an earlier frame left
   }
   for (auto& r : resolve_thread_ms) r = 0;
-  return overflows_before;
+  return before;
 }
 
 void Renderer::Impl::set_up_triangles() {
@@ -253,7 +257,7 @@ void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
       ms_between(r0, Clock::now()) - (raster.deferred_raster_ms() - deferred);
 }
 
-void Renderer::Impl::fill_stats(RenderStats& st, std::uint64_t overflows_before,
+void Renderer::Impl::fill_stats(RenderStats& st, const LifeCounters& before,
                                 const StageTimes& t) const {
   st.triangles_in = front_end.triangle_count();
   for (const auto& c : setup_counters) {
@@ -268,9 +272,12 @@ void Renderer::Impl::fill_stats(RenderStats& st, std::uint64_t overflows_before,
   for (const auto& r : rasterizers) {
     st.scratch_bytes += r->scratch_bytes();
     st.fragment_overflows += r->overflow_count();
+    st.hidden_bin_entries += r->hidden_draw_count();
     st.resolve_paths += r->take_resolve_paths();
   }
-  st.fragment_overflows -= overflows_before;  // the counters run over the Renderer's life
+  // The counters run over the Renderer's life.
+  st.fragment_overflows -= before.overflows;
+  st.hidden_bin_entries -= before.hidden_draws;
   st.setup_ms = ms_between(t.setup, t.binning);
   st.binning_ms = ms_between(t.binning, t.raster);
   // The tile pass interleaves raster and resolve per tile; the resolve share is the summed
@@ -320,7 +327,7 @@ RenderResult Renderer::render_frame() {
   const detail::FrameTarget target{&result.color, im.options.want_depth ? &result.depth : nullptr,
                                    keyed ? glm::vec3(0.0f) : im.scene.background_linear};
   const detail::FrameTarget white_target{&over_white, nullptr, glm::vec3(1.0f)};
-  const std::uint64_t overflows_before = im.begin_frame_counters();
+  const Impl::LifeCounters before = im.begin_frame_counters();
   Clock::time_point t0, t1, t2, t3, t4;
   detail::fork_join_execute(im.arena, [&] {
     t0 = Clock::now();
@@ -343,7 +350,7 @@ RenderResult Renderer::render_frame() {
     }
     t4 = Clock::now();
   });
-  im.fill_stats(result.stats, overflows_before, {t0, t1, t2, t3, t4});
+  im.fill_stats(result.stats, before, {t0, t1, t2, t3, t4});
   return result;
 }
 

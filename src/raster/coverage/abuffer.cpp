@@ -4,6 +4,8 @@
 // abuffer_resolve.cpp and abuffer_visibility.cpp.
 #include "raster/coverage/abuffer.hpp"
 
+#include "core/checks.hpp"
+
 #include "core/edge_function.hpp"
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
@@ -198,6 +200,42 @@ bool ABufferTile::add_covering_tile(const TriangleSetup& t, const PixelRect& r) 
   const int order = uniform_ == nullptr ? 1 : compare_planes(t, *uniform_, rect_);
   if (order > 0) uniform_ = &t;
   return order != 0;
+}
+
+bool ABufferTile::hides_pixel(const TriangleSetup& t, int x, int y) const {
+  const double centre_z = t.depth_at(x + 0.5, y + 0.5);  // the bits add() is given
+  const std::size_t b = block_of(x, y);
+  if (tile_uniform_ || block_uniform_[b]) {
+    // Not materialised: the block's opaque triangle, with the centre depth it would get.
+    const TriangleSetup* o = tile_uniform_ ? uniform_ : block_opaque_[b];
+    return o != nullptr &&
+           quick_order(t, centre_z, *o, o->depth_at(x + 0.5, y + 0.5)) == DepthOrder::Behind;
+  }
+  const std::size_t pixel = std::size_t(y - rect_.y0) * stride_ + (x - rect_.x0);
+  const double near = centre_z - depth_reach(t);
+  const bool behind_opaque =
+      opaque_[pixel] != nullptr &&
+      quick_order(t, centre_z, *opaque_[pixel], opaque_z_[pixel]) == DepthOrder::Behind;
+  if (log_.state(pixel) == LogState::Off) return near >= occluder_z_[pixel] || behind_opaque;
+  const int logged = log_.count(pixel);
+  if (logged == 0) {
+    // A partial fragment over a started list would turn the log off.
+    return head_[pixel] == kEnd && layer_[pixel] == Layer::Empty && behind_opaque;
+  }
+  if (near >= log_.hidden_from(pixel)) return true;
+  return logged < kMaxLoggedFragments && behind_opaque;  // at the limit: handed to the list
+}
+
+bool ABufferTile::hides_rect(const TriangleSetup& t, const PixelRect& r) const {
+  COVRAST_CHECK(r.x0 >= rect_.x0 && r.y0 >= rect_.y0 && r.x1 <= rect_.x1 && r.y1 <= rect_.y1,
+                "the pixels lie in the tile");
+  if (r.empty() || (r.x1 - r.x0) * (r.y1 - r.y0) > kMaxHiddenTestPx) return false;
+  for (int y = r.y0; y < r.y1; ++y) {
+    for (int x = r.x0; x < r.x1; ++x) {
+      if (!hides_pixel(t, x, y)) return false;
+    }
+  }
+  return true;
 }
 
 std::size_t ABufferTile::scratch_bytes() const {

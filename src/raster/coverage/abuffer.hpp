@@ -136,6 +136,14 @@ class ABufferTile {
   /// any block was decided; the caller skips their pixels (block_decided).
   bool add_covering_blocks(const TriangleSetup& t, const PixelRect& r);
   bool block_decided(int x, int y) const { return decided_[block_of(x, y)] == decided_stamp_; }
+  /// Whether add() would drop every fragment of opaque triangle `t` in the pixels `r` (at
+  /// most kMaxHiddenTestPx of them) as hidden, with no other effect: the same tests on the
+  /// same bits (a proven layer's hidden_from, the list's occluder depth, the opaque plane's
+  /// quick order), so that skipping the triangle leaves the tile as drawing it would.
+  /// Pixels where a fragment would change state (a log at its limit hands over to the list,
+  /// an empty log over a started list turns off) answer no.
+  bool hides_rect(const TriangleSetup& t, const PixelRect& r) const;
+  static constexpr int kMaxHiddenTestPx = 64;
   /// A fragment of a BLEND triangle (TriangleAlpha::Blend), which prepare_row() has made
   /// ready: kept in the pixel's own transparent list, apart from the opaque fragments, and
   /// composited in depth order at the resolve (abuffer_transparency.cpp).
@@ -205,6 +213,8 @@ class ABufferTile {
 
   inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
                                          std::size_t pixel, int x, int y) const;
+  /// Whether add() would drop the fragment of `t` at pixel (x, y) as hidden (hides_rect).
+  bool hides_pixel(const TriangleSetup& t, int x, int y) const;
   /// add() for a pixel whose log is not Off: logs the fragment, drops it (hidden), or returns
   /// false for the list to take it (after turning the log Off and handing its fragments on).
   inline bool log_fragment(std::size_t pixel, int x, int y, const TriangleSetup& t,
@@ -432,15 +442,23 @@ DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, i
 /// order_of, decided in most cases from the planes' difference at the pixel centre and a
 /// bound on how far it can move towards a corner: |d(corner) - d(centre)| <=
 /// (|ddz/dx| + |ddz/dy|) / 2. Near ties it falls back to the exact corner comparison.
-inline DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, double t_centre_z,
-                                                    std::size_t pixel, int x, int y) const {
-  const TriangleSetup& o = *opaque_[pixel];
-  const double d = t_centre_z - opaque_z_[pixel];
+/// The order of t's plane against the opaque plane o over a pixel, from their centre depths
+/// and slopes alone; Crossing when that does not decide it (order_of then does).
+inline DepthOrder quick_order(const TriangleSetup& t, double t_centre_z, const TriangleSetup& o,
+                              double o_centre_z) {
+  const double d = t_centre_z - o_centre_z;
   const double reach = 0.5 * (std::fabs(t.dzdx - o.dzdx) + std::fabs(t.dzdy - o.dzdy));
   constexpr double kMargin = 1e-12;  // far above the rounding of z in [0, 1]
   if (d + reach < -kMargin) return DepthOrder::InFront;
   if (d - reach > kMargin) return DepthOrder::Behind;
-  return order_of(t, o, x, y);
+  return DepthOrder::Crossing;
+}
+
+inline DepthOrder ABufferTile::order_against_opaque(const TriangleSetup& t, double t_centre_z,
+                                                    std::size_t pixel, int x, int y) const {
+  const TriangleSetup& o = *opaque_[pixel];
+  const DepthOrder quick = quick_order(t, t_centre_z, o, opaque_z_[pixel]);
+  return quick != DepthOrder::Crossing ? quick : order_of(t, o, x, y);
 }
 
 inline void ABufferTile::prepare_row(int x0, int x1, int y) {
