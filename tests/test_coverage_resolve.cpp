@@ -1044,6 +1044,24 @@ Scene default_like_scene() {
   return s;
 }
 
+/// A coverage render of `s` at `tile` (2 threads, with depth) with the fast paths on, and with
+/// every triangle drawn pixel by pixel (testing hook pixel_path_only), which must match.
+struct FastAndSlow {
+  covrast::RenderResult fast, slow;
+};
+FastAndSlow render_with_and_without_fast_paths(const Scene& s, int tile) {
+  RenderOptions o;
+  o.mode.kind = ModeKind::Coverage;
+  o.tile = tile;
+  o.threads = 2;
+  o.want_depth = true;
+  FastAndSlow r{covrast::render(s, o), {}};
+  const covrast::test::ScopedHook pixels_only(
+      covrast::detail::testing::coverage_hooks.pixel_path_only, true);
+  r.slow = covrast::render(s, o);
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("coverage mode: byte-identical for every thread count, tile and SIMD target",
@@ -1151,17 +1169,7 @@ TEST_CASE("coverage resolve: whole-tile and whole-block paths give what pixel-by
     add_instance(s, screen_mesh(s, small), glm::vec3(1), ColorSource::PerTriangle);
     for (int tile : {8, 32, 64}) {
       INFO("round " << round << ", tile " << tile);
-      RenderOptions o;
-      o.mode.kind = ModeKind::Coverage;
-      o.tile = tile;
-      o.threads = 2;
-      o.want_depth = true;
-      const auto fast = covrast::render(s, o);
-      const auto slow = [&] {
-        const covrast::test::ScopedHook pixels_only(
-            covrast::detail::testing::coverage_hooks.pixel_path_only, true);
-        return covrast::render(s, o);
-      }();
+      const auto [fast, slow] = render_with_and_without_fast_paths(s, tile);
       fast_blocks += fast.stats.resolve_paths.uniform_tile + fast.stats.resolve_paths.uniform_block;
       slow_blocks += slow.stats.resolve_paths.uniform_tile + slow.stats.resolve_paths.uniform_block;
       REQUIRE(fast.color.rgb.size() == slow.color.rgb.size());
@@ -1190,18 +1198,8 @@ TEST_CASE("coverage: small triangles hidden in every pixel they touch skip the k
   }
   for (int tile : {16, 64}) {
     INFO("tile " << tile);
-    RenderOptions o;
-    o.mode.kind = ModeKind::Coverage;
-    o.tile = tile;
-    o.threads = 2;
-    o.want_depth = true;
-    const auto fast = covrast::render(s, o);
-    const auto slow = [&] {
-      // Every triangle drawn pixel by pixel: the skip is off with the other fast paths.
-      const covrast::test::ScopedHook pixels_only(
-          covrast::detail::testing::coverage_hooks.pixel_path_only, true);
-      return covrast::render(s, o);
-    }();
+    // Pixel by pixel, the skip is off with the other fast paths.
+    const auto [fast, slow] = render_with_and_without_fast_paths(s, tile);
     INFO("hidden bin entries " << fast.stats.hidden_bin_entries << " of "
                                << fast.stats.bin_entries);
     CHECK(fast.stats.hidden_bin_entries > fast.stats.bin_entries / 5);
