@@ -168,10 +168,12 @@ template <class Merged>
 bool nearest_at_point(int n, const TriangleSetup* const* tri, const Merged* const* merged, int i,
                       double px, double py) {
   const double z = tri[i]->depth_at(px, py);
+  // Nearer first: the depth is two products, the cover test three edge functions, and in
+  // a mixed pixel most fragments lie behind the sliver.
   auto hides = [&](const TriangleSetup& o) {
-    if (!covers_point(o, px, py)) return false;
     const double oz = o.depth_at(px, py);
-    return oz < z || (oz == z && o.primitive < tri[i]->primitive);
+    if (!(oz < z || (oz == z && o.primitive < tri[i]->primitive))) return false;
+    return covers_point(o, px, py);
   };
   for (int j = 0; j < n; ++j) {
     if (j == i) continue;
