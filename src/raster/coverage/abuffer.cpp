@@ -5,7 +5,6 @@
 #include "raster/coverage/abuffer.hpp"
 
 #include "core/checks.hpp"
-
 #include "core/edge_function.hpp"
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"

@@ -439,11 +439,10 @@ class ABufferTile {
 /// pixel's four corners (abuffer.cpp).
 DepthOrder order_of(const TriangleSetup& t, const TriangleSetup& other, int x, int y);
 
-/// order_of, decided in most cases from the planes' difference at the pixel centre and a
-/// bound on how far it can move towards a corner: |d(corner) - d(centre)| <=
-/// (|ddz/dx| + |ddz/dy|) / 2. Near ties it falls back to the exact corner comparison.
-/// The order of t's plane against the opaque plane o over a pixel, from their centre depths
-/// and slopes alone; Crossing when that does not decide it (order_of then does).
+/// order_of's answer where the planes' difference at the pixel centre and a bound on how far
+/// it can move towards a corner decide it: |d(corner) - d(centre)| <= (|ddz/dx| + |ddz/dy|)
+/// / 2. Crossing near ties, where order_against_opaque falls back to the exact corner
+/// comparison (order_of) and hides_pixel answers no.
 inline DepthOrder quick_order(const TriangleSetup& t, double t_centre_z, const TriangleSetup& o,
                               double o_centre_z) {
   const double d = t_centre_z - o_centre_z;

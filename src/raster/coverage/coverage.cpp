@@ -64,16 +64,15 @@ class CoverageRasterizer final : public TileRasterizer {
       if (previous_ != nullptr && same_geometry(*previous_, t)) return;
       if (t.alpha_mode == TriangleAlpha::Opaque) previous_ = &t;
     }
-    // A small opaque triangle whose every pixel would drop its fragment as hidden: no
-    // kernel, no fragments (on dense meshes a quarter to two thirds of them).
-    if (!blend_ && fast_paths_ && t.alpha_mode == TriangleAlpha::Opaque &&
-        abuffer_.hides_rect(t, r)) {
-      ++hidden_draws_;
-      return;
-    }
     bool skip_decided = false;
-    // The tile and block paths assume an opaque triangle covering the pixels entirely.
+    // The fast paths are for opaque triangles: one whose every pixel would drop its fragment
+    // as hidden (no kernel, no fragments: on dense meshes a quarter to two thirds of them),
+    // and the tile and block paths for one covering the pixels entirely.
     if (!blend_ && fast_paths_ && t.alpha_mode == TriangleAlpha::Opaque) {
+      if (abuffer_.hides_rect(t, r)) {
+        ++hidden_draws_;
+        return;
+      }
       if (abuffer_.add_covering_tile(t, r)) return;
       // Only a triangle at least a block wide and high can cover a whole block.
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);

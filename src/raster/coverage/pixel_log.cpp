@@ -141,16 +141,21 @@ void PixelLog::append(std::size_t pixel, int x, int y, const TriangleSetup& t,
   }
   far_[pixel] = std::max(far_[pixel], centre_z + reach);
   if (coverage_sum_[pixel] < std::uint32_t(kCoverageOne)) return;
-  // Pieces of one facing of a convex surface do not overlap (TriangleSetup::convex_surface):
-  // reaching the pixel, they cover it, as the list's open set closes.
-  if (convex_[pixel] != kNotConvex ||
-      (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2)) {
+  if (sums_prove_layer(pixel)) {
     state_[pixel] = LogState::Proven;
     hidden_from_[pixel] = far_[pixel];
   } else {
     state_[pixel] = LogState::Mixed;
     restart_sums(pixel);
   }
+}
+
+bool PixelLog::sums_prove_layer(std::size_t pixel) const {
+  // Pieces of one facing of a convex surface do not overlap (TriangleSetup::convex_surface):
+  // reaching the pixel, they cover it, as the list's open set closes. Otherwise the header's
+  // proof: a zero key sum and less than 1.5 pixels of area.
+  return convex_[pixel] != kNotConvex ||
+         (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2);
 }
 
 void PixelLog::restart_sums(std::size_t pixel) {
@@ -162,21 +167,24 @@ void PixelLog::restart_sums(std::size_t pixel) {
 void PixelLog::prove_later_layer(std::size_t pixel, int x, int y, const TriangleSetup& t,
                                  std::uint32_t coverage, double far) {
   const std::uint64_t key = crossing_key(t, coverage, x, y);
-  const bool first = coverage_sum_[pixel] == 0;
-  if (first || convex_[pixel] != convex_key(t)) convex_[pixel] = first ? convex_key(t) : kNotConvex;
+  const std::uint32_t convex = convex_key(t);
+  if (coverage_sum_[pixel] == 0) {
+    convex_[pixel] = convex;  // the run's first fragment
+  } else if (convex_[pixel] != convex) {
+    convex_[pixel] = kNotConvex;
+  }
   coverage_sum_[pixel] += coverage;
   key_sum_[pixel] += key;
   far_[pixel] = std::max(far_[pixel], far);
   if (coverage_sum_[pixel] < std::uint32_t(kCoverageOne)) return;
-  if (convex_[pixel] != kNotConvex ||
-      (key_sum_[pixel] == 0 && coverage_sum_[pixel] < 3 * std::uint32_t(kCoverageOne) / 2)) {
+  if (sums_prove_layer(pixel)) {
     // The run since the last restart tiles the pixel: nothing behind its farthest depth shows.
     hidden_from_[pixel] = std::min(hidden_from_[pixel], far_[pixel]);
     restart_sums(pixel);
     return;
   }
   // No proof: the next run starts with this fragment, which may begin a layer.
-  convex_[pixel] = convex_key(t);
+  convex_[pixel] = convex;
   coverage_sum_[pixel] = coverage;
   key_sum_[pixel] = key;
   far_[pixel] = far;

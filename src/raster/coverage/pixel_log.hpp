@@ -162,6 +162,8 @@ class PixelLog {
   std::vector<std::uint64_t> key_sum_;
   std::vector<double> far_;
   std::vector<double> hidden_from_;
+  /// Whether the running sums, once they reach the pixel, prove a layer.
+  bool sums_prove_layer(std::size_t pixel) const;
   void restart_sums(std::size_t pixel);
   /// Once Mixed: adds a fragment to the run and lowers hidden_from when the run proves a layer.
   void prove_later_layer(std::size_t pixel, int x, int y, const TriangleSetup& t,
