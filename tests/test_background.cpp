@@ -5,7 +5,7 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 
 #include <catch2/catch.hpp>
 

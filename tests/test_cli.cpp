@@ -3,10 +3,11 @@
 // untouched. Each test writes its scenes, meshes and images into a fresh temporary directory.
 #include <covrast/image.hpp>
 #include <covrast/renderer.hpp>
+#include <covrast/tools.hpp>
 
 #include <sys/wait.h>
 #include <unistd.h>
-#include "core/srgb.hpp"
+#include "color/srgb.hpp"
 
 #include <catch2/catch.hpp>
 

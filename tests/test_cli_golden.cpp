@@ -4,6 +4,7 @@
 // the tolerances; --shard and --filter; and every malformed manifest exits 2 naming the case and
 // field, without writing anything.
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 #include <catch2/catch.hpp>
 

@@ -3,6 +3,7 @@
 #include <covrast/compare.hpp>
 #include <covrast/error.hpp>
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 #include <catch2/catch.hpp>
 #include <nlohmann/json.hpp>

@@ -5,7 +5,7 @@
 #include <covrast/error.hpp>
 #include <covrast/image.hpp>
 
-#include "core/srgb.hpp"
+#include "color/srgb.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,4 +1,4 @@
-// Image-based lighting (core/environment_lighting.hpp, docs/environments.md) on a finely
+// Image-based lighting (shading/environment_lighting.hpp, docs/environments.md) on a finely
 // tessellated unit sphere with exact normals, each case against a computation that does not
 // share its method: brute-force quadrature of the glTF BRDF (white furnace), the closed-form
 // irradiance of a linear environment, a directional light, and a rotated scene.
@@ -6,9 +6,9 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/environment_lighting.hpp"
-#include "core/shading_inputs.hpp"
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
+#include "shading/environment_lighting.hpp"
+#include "shading/shading_inputs.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -307,7 +307,7 @@ StudioErrors studio_against_brute_force(std::initializer_list<double> roughnesse
   for (const double metallic : {0.0, 1.0}) {
     for (const double roughness : roughnesses) {
       covrast::detail::SurfaceShading surface;
-      surface.model = covrast::detail::LitModel::Pbr;
+      surface.model = covrast::ShadingModel::Pbr;
       surface.metallic = metallic;
       surface.roughness = roughness;
       surface.context = &context;

@@ -2,6 +2,7 @@
 // and PFM layouts, and atomic writes (no temporary files left behind, the target untouched on
 // failure). The 16-bit PNG is decoded with stb_image, a decoder independent of our encoder.
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 #include <stb/stb_image.h>
 #include <stb/stb_image_write.h>

@@ -9,9 +9,9 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/environment_lighting.hpp"
-#include "core/shading_inputs.hpp"
-#include "core/sheen.hpp"
+#include "shading/environment_lighting.hpp"
+#include "shading/shading_inputs.hpp"
+#include "shading/sheen.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -32,6 +32,7 @@ using Catch::Matchers::Contains;
 using covrast::Light;
 using covrast::LightType;
 using covrast::Material;
+using covrast::ShadingModel;
 
 namespace {
 
@@ -471,7 +472,7 @@ TEST_CASE("the clear coat under the environment with its suns and the ambient li
   sun.radiance = glm::dvec3(1.5);
   context.lights = {sun};
   SurfaceShading coated;
-  coated.model = LitModel::Pbr;
+  coated.model = ShadingModel::Pbr;
   coated.metallic = 0.2;
   coated.roughness = 0.55;
   coated.occlusion = 0.8;
@@ -765,7 +766,7 @@ TEST_CASE("the sheen under the studio environment against quadrature over its te
   ShadingContext context;
   context.environment = &lighting;
   SurfaceShading with;
-  with.model = LitModel::Pbr;
+  with.model = ShadingModel::Pbr;
   with.metallic = 0.0;
   with.roughness = 0.7;
   with.context = &context;
@@ -861,7 +862,7 @@ TEST_CASE("anisotropy under the environment reads it about the bent normal",
   ShadingContext context;
   context.environment = &lighting;
   SurfaceShading s;
-  s.model = LitModel::Pbr;
+  s.model = ShadingModel::Pbr;
   s.metallic = 1.0;  // a metal: F0 = base, no diffuse, so the specular is all there is
   s.roughness = 0.3;
   s.context = &context;

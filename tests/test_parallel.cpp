@@ -3,6 +3,7 @@
 // and an exception thrown by one call reaches the caller.
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
+#include <covrast/tools.hpp>
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>

@@ -1,4 +1,4 @@
-// Tests of lighting (docs/shading.md; src/core/shading.cpp, the front end's shading inputs,
+// Tests of lighting (docs/shading.md; src/shading/shading.cpp, the front end's shading inputs,
 // the scene keys "lights", "material", "normals", glTF NORMAL and materials, OBJ vn): analytic
 // images of a sphere and a cube against their formulas, the pbr BRDF against an independent
 // evaluation of the glTF specification's Appendix B and an energy bound, determinism across
@@ -7,8 +7,8 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/shading_inputs.hpp"
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
+#include "shading/shading_inputs.hpp"
 
 #include <catch2/catch.hpp>
 #include <glm/gtc/matrix_transform.hpp>

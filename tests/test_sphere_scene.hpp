@@ -6,7 +6,7 @@
 #include <covrast/image.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -4,7 +4,7 @@
 // Most tests drive the tile rasterizers directly with screen triangles built here from
 // 24.8 fixed-point vertices, so the geometry is known exactly and the resolved linear
 // colours can be read before 8-bit encoding; the scene tests go through covrast::render.
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 #include "core/testing_hooks.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/rasterizers.hpp"

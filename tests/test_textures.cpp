@@ -8,10 +8,10 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/shading_inputs.hpp"
-#include "core/texture_sampling.hpp"
 #include "raster/coverage/fragment_shading.hpp"
 #include "scene/scene_internal.hpp"
+#include "shading/shading_inputs.hpp"
+#include "texture/texture_sampling.hpp"
 
 #include <turbojpeg.h>
 #include <webp/encode.h>
@@ -1329,7 +1329,7 @@ TEST_CASE("textures: coverage mode's texture is the exact mean over the pixel", 
   // mean blends up to four. LINEAR: the bilinear filter bends at texel centres 3/4 of a pixel
   // apart, so its value at the pixel centre is not the pixel's mean. Coverage mode
   // integrates the filter over each triangle's part of the pixel
-  // (raster/coverage/fragment_shading.hpp, core/texture_sampling.hpp area_average): the exact
+  // (raster/coverage/fragment_shading.hpp, texture/texture_sampling.hpp area_average): the exact
   // mean, on the quad's diagonal too.
   const int size = 48, texels = 64;
   for (const covrast::TextureFilter filter :

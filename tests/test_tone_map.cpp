@@ -1,10 +1,10 @@
-// Tone mapping and exposure (core/tone_map.hpp, docs/shading.md): each operator against its
+// Tone mapping and exposure (color/tone_map.hpp, docs/shading.md): each operator against its
 // published formula written out again here, known values, and what it does to a frame.
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/srgb8.hpp"
-#include "core/tone_map.hpp"
+#include "color/srgb8.hpp"
+#include "color/tone_map.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -13,8 +13,8 @@
 
 #include "test_meshes.hpp"
 
+using covrast::ToneMap;
 using covrast::detail::tone_map;
-using covrast::detail::ToneMapOperator;
 using covrast::detail::ToneMapping;
 
 namespace {
@@ -69,10 +69,10 @@ TEST_CASE("tone map: every operator follows its published formula on a ramp", "[
     for (const double exposure : {1.0, 0.5, 2.0}) {
       INFO("x " << x << ", exposure " << exposure);
       const glm::dvec3 e = c * exposure;
-      const glm::dvec3 neutral = tone_map({ToneMapOperator::KhronosPbrNeutral, exposure}, c);
-      const glm::dvec3 hill = tone_map({ToneMapOperator::AcesHill, exposure}, c);
-      const glm::dvec3 nark = tone_map({ToneMapOperator::AcesNarkowicz, exposure}, c);
-      const glm::dvec3 none = tone_map({ToneMapOperator::None, exposure}, c);
+      const glm::dvec3 neutral = tone_map({ToneMap::KhronosPbrNeutral, exposure}, c);
+      const glm::dvec3 hill = tone_map({ToneMap::AcesHill, exposure}, c);
+      const glm::dvec3 nark = tone_map({ToneMap::AcesNarkowicz, exposure}, c);
+      const glm::dvec3 none = tone_map({ToneMap::None, exposure}, c);
       for (int k = 0; k < 3; ++k) {
         CHECK(neutral[k] == Approx(neutral_reference(e)[k]).margin(1e-12));
         CHECK(hill[k] == Approx(hill_reference(e)[k]).margin(1e-12));
@@ -84,7 +84,7 @@ TEST_CASE("tone map: every operator follows its published formula on a ramp", "[
 }
 
 TEST_CASE("tone map: known values", "[tonemap]") {
-  const ToneMapping neutral{ToneMapOperator::KhronosPbrNeutral, 1.0};
+  const ToneMapping neutral{ToneMap::KhronosPbrNeutral, 1.0};
   CHECK(tone_map(neutral, glm::dvec3(0.0)) == glm::dvec3(0.0));
   // Grey 0.5: only the 0.04 offset (below the compression start).
   CHECK(tone_map(neutral, glm::dvec3(0.5)).r == Approx(0.46).margin(1e-15));
@@ -92,12 +92,12 @@ TEST_CASE("tone map: known values", "[tonemap]") {
   CHECK(tone_map(neutral, glm::dvec3(1.0)).r == Approx(1.0 - 0.0576 / 0.44).margin(1e-12));
   // Never reaches 1, however bright.
   CHECK(tone_map(neutral, glm::dvec3(1e6)).r < 1.0);
-  const ToneMapping nark{ToneMapOperator::AcesNarkowicz, 1.0};
+  const ToneMapping nark{ToneMap::AcesNarkowicz, 1.0};
   CHECK(tone_map(nark, glm::dvec3(1.0)).r == Approx(2.54 / 3.16).margin(1e-15));
   CHECK(tone_map(nark, glm::dvec3(100.0)).r == 1.0);
-  CHECK(tone_map({ToneMapOperator::AcesHill, 1.0}, glm::dvec3(0.0)) == glm::dvec3(0.0));
+  CHECK(tone_map({ToneMap::AcesHill, 1.0}, glm::dvec3(0.0)) == glm::dvec3(0.0));
   CHECK(ToneMapping{}.is_identity());
-  CHECK_FALSE((ToneMapping{ToneMapOperator::None, 2.0}.is_identity()));
+  CHECK_FALSE((ToneMapping{ToneMap::None, 2.0}.is_identity()));
 }
 
 TEST_CASE("tone map: names", "[tonemap]") {

@@ -26,10 +26,6 @@ struct CompareResult {
 /// Throws InputError if the sizes differ.
 CompareResult compare_images(const Image& a, const Image& b);
 
-/// A heat map of the per-pixel maximum channel difference (black = equal, through
-/// blue, green, yellow to red = 32/255 or more), same size as the inputs.
-Image difference_heatmap(const Image& a, const Image& b);
-
 /// One-line JSON summary of a comparison (keys as the fields above, in that order);
 /// psnr_db is null when the images are identical (PSNR = +infinity).
 std::string to_json(const CompareResult& result);

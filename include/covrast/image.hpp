@@ -47,9 +47,6 @@ void write_png(const Image& image, const std::filesystem::path& path,
 /// The PNG file write_png writes, in memory (for embedding, e.g. in an HTML report).
 std::vector<std::uint8_t> encode_png(const Image& image, const std::vector<PngText>& text = {});
 
-/// The tEXt records of a PNG file, in file order. Throws InputError when it is not a PNG.
-std::vector<PngText> read_png_text(const std::filesystem::path& path);
-
 /// Writes depth as 16-bit greyscale PNG (.png) or as a little-endian PFM (.pfm), atomically.
 void write_depth(const DepthImage& depth, const std::filesystem::path& path);
 

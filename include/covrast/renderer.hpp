@@ -12,7 +12,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -53,23 +52,5 @@ class Renderer {
 /// One frame, convenience: Renderer(scene, options).render_frame(), with the same
 /// preconditions and exceptions.
 RenderResult render(const Scene& scene, const RenderOptions& options);
-
-/// Runs work(i) for every i in [0, count), several at once on up to `threads` worker threads
-/// (0: all hardware threads; at most kMaxThreads), each call on one thread, and returns when
-/// all have run: for programs that render many small frames at once (covrast test renders one
-/// case per call, with RenderOptions::threads = 1). When a call throws, the calls not yet
-/// started are skipped and the first exception is rethrown here.
-void for_each_in_parallel(std::size_t count, int threads,
-                          const std::function<void(std::size_t)>& work);
-
-/// What this build of covrast is and runs on: what golden images record and test reports
-/// print, so that a mismatch says what rendered each side.
-struct BuildInfo {
-  std::string version;      ///< covrast's version (project() in CMakeLists.txt)
-  std::string compiler;     ///< e.g. "g++ 12.2.0"
-  std::string simd_target;  ///< the Highway target the kernels run on, e.g. "AVX3"
-  std::string cpu;          ///< the processor's model name
-};
-BuildInfo build_info();
 
 }  // namespace covrast

@@ -7,6 +7,7 @@
 
 #include <covrast/environment.hpp>
 #include <covrast/error.hpp>
+#include <covrast/shading.hpp>
 #include <covrast/texture.hpp>
 
 #include <glm/glm.hpp>
@@ -57,22 +58,6 @@ struct Camera {
   double far = 100.0;         ///< far plane distance [world units], > near
   bool orthographic = false;  ///< parallel projection: ymag instead of fovy_deg
   double ymag = 1.0;          ///< orthographic: half the view's height [world units], > 0
-};
-
-/// How a lit surface reflects light (docs/shading.md has every formula and its source).
-enum class ShadingModel : std::uint8_t {
-  Unlit,       ///< the base colour as is, today's flat, unlit look (KHR_materials_unlit)
-  Lambert,     ///< base * (ambient + sum E_i max(0, n . l_i)), no 1/pi
-  BlinnPhong,  ///< Lambert plus specular * max(0, n . h)^shininess per light
-  Pbr,         ///< glTF 2.0 metallic-roughness BRDF (specification, Appendix B)
-};
-
-/// How a material's alpha (base_alpha x vertex alpha x texture alpha) is used (glTF 2.0,
-/// 3.9.4 alphaMode; docs/transparency.md).
-enum class AlphaMode : std::uint8_t {
-  Opaque,  ///< alpha ignored: the surface hides what is behind it
-  Mask,    ///< kept where alpha >= alpha_cutoff, opaque there, absent elsewhere
-  Blend,   ///< composited over what is behind it with its alpha, in depth order
 };
 
 /// A surface's material. The base colour is not here: it is the mesh's colour selection
@@ -171,10 +156,6 @@ struct Material {
 };
 
 enum class LightType : std::uint8_t { Directional, Point, Spot, Ambient };
-
-/// Tone mapping of every shaded colour (not the background colour), in linear light
-/// (docs/shading.md, "Tone mapping and exposure"): None is today's output (exposure still scales).
-enum class ToneMap : std::uint8_t { None, KhronosPbrNeutral, AcesHill, AcesNarkowicz };
 
 /// "none", "khronos-pbr-neutral", "aces-hill", "aces-narkowicz"; throws InputError naming the
 /// accepted names for anything else.

@@ -9,6 +9,7 @@
 #include <covrast/compare.hpp>
 #include <covrast/error.hpp>
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 #include <iostream>
 #include <string>

@@ -5,6 +5,7 @@
 
 #include <covrast/compare.hpp>
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 #include <filesystem>
 #include <string>

@@ -13,6 +13,7 @@
 #include <covrast/error.hpp>
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
+#include <covrast/tools.hpp>
 
 #include <unistd.h>
 

@@ -9,6 +9,7 @@
 #include <covrast/image.hpp>
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
+#include <covrast/tools.hpp>
 
 #include <nlohmann/json.hpp>
 

@@ -1,6 +1,6 @@
 // Convex polygons clipped to boxes, and their areas: the part of a triangle in a pixel
 // (coverage mode's texture footprint, raster/coverage/fragment_shading.cpp) and the part of
-// that footprint in each texel (core/texture.cpp). Sutherland and Hodgman, "Reentrant polygon
+// that footprint in each texel (texture/texture.cpp). Sutherland and Hodgman, "Reentrant polygon
 // clipping" (CACM 17(1), 1974), one half-plane at a time; the area by the shoelace formula.
 #pragma once
 

@@ -6,6 +6,8 @@
 // [x, x+1] x [y, y+1], y down, row 0 at the top.
 #pragma once
 
+#include <covrast/shading.hpp>
+
 #include <glm/glm.hpp>
 
 #include <algorithm>
@@ -23,11 +25,7 @@ inline constexpr double kGuardBandPx = 16384.0;
 
 inline constexpr std::uint32_t kNoTriangle = 0xffffffffu;
 
-struct ShadingRecord;  // core/shading_inputs.hpp
-
-/// covrast::AlphaMode, mirrored here (core does not include the scene API). Non-opaque
-/// triangles always have a ShadingRecord, which holds what their alpha is made of.
-enum class TriangleAlpha : std::uint8_t { Opaque, Mask, Blend };
+struct ShadingRecord;  // shading/shading_inputs.hpp
 
 struct TriangleSetup {
   /// Vertices in 24.8 fixed point, ordered so that the doubled signed area
@@ -51,7 +49,9 @@ struct TriangleSetup {
   /// Of a convex mesh under an affine model matrix: triangles of one surface and facing with
   /// this flag never overlap on screen (the A-buffer skips their overlap test).
   bool convex_surface;
-  TriangleAlpha alpha_mode;  ///< Opaque unless the material says otherwise
+  /// Opaque unless the material says otherwise. Non-opaque triangles always have a
+  /// ShadingRecord, which holds what their alpha is made of.
+  AlphaMode alpha_mode;
 
   double depth_at(double x_px, double y_px) const {
     return z0 + dzdx * (x_px - x_fx8[0] * (1.0 / kSubpixelOne)) +

@@ -25,7 +25,7 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
       height_px_(height_px),
       cull_hidden_backfaces_(cull_hidden_backfaces),
       eye_(scene.camera.eye) {
-  context_.tone_mapping = {ToneMapOperator(int(scene.tone_map)), scene.exposure};
+  context_.tone_mapping = {scene.tone_map, scene.exposure};
   const Camera& cam = scene.camera;
   glm::dmat4 view = glm::lookAt(cam.eye, cam.target, cam.up);
   const double aspect = double(width_px) / double(height_px);
@@ -251,8 +251,8 @@ void GeometryFrontEnd::setup_lit_run(std::size_t instance, std::uint64_t g, std:
     }
     // Unlit and untextured: no shading inputs at all, the unlit path bit for bit; unlit
     // non-opaque ones get a record for their alpha (vertex alphas only, no positions or normals).
-    const bool unlit = lit->model == LitModel::Unlit && lit->textures == nullptr;
-    const bool record = !unlit || lit->alpha_mode != TriangleAlpha::Opaque;
+    const bool unlit = lit->model == ShadingModel::Unlit && lit->textures == nullptr;
+    const bool record = !unlit || lit->alpha_mode != AlphaMode::Opaque;
     ShadeVertex shade[3];
     if (unlit && record) vertex_alphas(instance, local, shade);
     if ((o0 | o1 | o2) == 0) {

@@ -14,9 +14,9 @@
 // (inline), frontend_shading.cpp; frontend_stages.hpp declares what they share.
 #pragma once
 
-#include "core/environment_lighting.hpp"
-#include "core/shading_inputs.hpp"
 #include "core/triangle_setup.hpp"
+#include "shading/environment_lighting.hpp"
+#include "shading/shading_inputs.hpp"
 
 #include <covrast/scene.hpp>
 

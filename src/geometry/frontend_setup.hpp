@@ -60,7 +60,7 @@ namespace covrast::detail {
   t.flat_color = flat;
   t.convex_surface = convex_surface;
   t.shading = nullptr;
-  t.alpha_mode = TriangleAlpha::Opaque;
+  t.alpha_mode = AlphaMode::Opaque;
   if (unlit_tone_mapping != nullptr && !unlit_tone_mapping->is_identity()) {
     // Unlit colours are tone-mapped at the vertices (exact for uniform and per-triangle
     // colours; lit ones are tone-mapped where shade_lit makes them).

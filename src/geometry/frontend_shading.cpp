@@ -1,5 +1,5 @@
 // Geometry stage, shading set-up (frontend.hpp): the frame's lights and each instance's
-// materials in the form shade() evaluates them (core/shading_inputs.hpp), the per-corner
+// materials in the form shade() evaluates them (shading/shading_inputs.hpp), the per-corner
 // shading inputs of each lit triangle the front end sets up (world positions and normals,
 // UVs and tangents, vertex alphas), and its ShadingRecord.
 #include "geometry/frontend.hpp"
@@ -11,7 +11,7 @@ namespace covrast::detail {
 
 namespace {
 
-/// A scene light in the form shade() evaluates (core/shading_inputs.hpp); ambient lights
+/// A scene light in the form shade() evaluates (shading/shading_inputs.hpp); ambient lights
 /// are summed into the context instead.
 PunctualLight punctual_light(const Light& light) {
   PunctualLight p;
@@ -105,14 +105,14 @@ namespace {
 
 SurfaceShading surface_shading(const Material& m, const ShadingContext* context) {
   SurfaceShading s;
-  s.model = LitModel(int(m.model));
+  s.model = m.model;
   s.metallic = m.metallic;
   s.roughness = m.roughness;
   s.emissive = glm::dvec3(m.emissive_linear);
   s.specular = glm::dvec3(m.specular_linear);
   s.shininess = m.shininess;
   s.double_sided = m.double_sided;
-  s.alpha_mode = TriangleAlpha(int(m.alpha_mode));
+  s.alpha_mode = m.alpha_mode;
   s.alpha_cutoff = m.alpha_cutoff;
   s.base_alpha = m.base_alpha;
   s.context = context;
@@ -135,18 +135,6 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
       glm::dvec2(std::cos(double(m.anisotropy_rotation)), std::sin(double(m.anisotropy_rotation)));
   return s;
 }
-
-static_assert(int(ShadingModel::Unlit) == int(LitModel::Unlit) &&
-              int(ShadingModel::Lambert) == int(LitModel::Lambert) &&
-              int(ShadingModel::BlinnPhong) == int(LitModel::BlinnPhong) &&
-              int(ShadingModel::Pbr) == int(LitModel::Pbr));
-static_assert(int(ToneMap::None) == int(ToneMapOperator::None) &&
-              int(ToneMap::KhronosPbrNeutral) == int(ToneMapOperator::KhronosPbrNeutral) &&
-              int(ToneMap::AcesHill) == int(ToneMapOperator::AcesHill) &&
-              int(ToneMap::AcesNarkowicz) == int(ToneMapOperator::AcesNarkowicz));
-static_assert(int(AlphaMode::Opaque) == int(TriangleAlpha::Opaque) &&
-              int(AlphaMode::Mask) == int(TriangleAlpha::Mask) &&
-              int(AlphaMode::Blend) == int(TriangleAlpha::Blend));
 
 }  // namespace
 
@@ -184,7 +172,7 @@ void GeometryFrontEnd::prepare_lighting() {
     for (const Material& m : materials) textures_[i].push_back(surface_slots(m, scene_.lit));
     for (std::size_t k = 0; k < materials.size(); ++k) {
       SurfaceShading surface = surface_shading(materials[k], &context_);
-      if (!scene_.lit) surface.model = LitModel::Unlit;  // textured in a scene without lights
+      if (!scene_.lit) surface.model = ShadingModel::Unlit;  // textured in a scene without lights
       // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
       // whether or not it has textures.
       surface.has_texture_slots = any_texture(textures_[i][k]);

@@ -4,7 +4,8 @@
 // reproducible.
 #include <covrast/compare.hpp>
 #include <covrast/error.hpp>
-#include "core/srgb.hpp"
+#include <covrast/tools.hpp>
+#include "color/srgb.hpp"
 
 #include <nlohmann/json.hpp>
 

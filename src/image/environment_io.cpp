@@ -7,8 +7,8 @@
 #include <covrast/error.hpp>
 #include <covrast/image.hpp>
 
+#include "color/srgb.hpp"
 #include "core/file_read.hpp"
-#include "core/srgb.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -218,7 +218,7 @@ EnvironmentMap decode_exr(const std::uint8_t* bytes, std::size_t size, const std
 }
 #endif
 
-/// 8-bit PNG or JPEG as sRGB: each code through the exact sRGB decode (core/srgb.hpp).
+/// 8-bit PNG or JPEG as sRGB: each code through the exact sRGB decode (color/srgb.hpp).
 EnvironmentMap decode_ldr(const std::uint8_t* bytes, std::size_t size, const std::string& name) {
   const RgbaImage image = decode_image(bytes, size, name);
   check_size(name, image.width, image.height);

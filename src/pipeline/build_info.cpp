@@ -1,6 +1,7 @@
 // What this build of covrast is and what it runs on (renderer.hpp): the line that golden
 // images record and that test reports print, so that a mismatch says what rendered each side.
 #include <covrast/renderer.hpp>
+#include <covrast/tools.hpp>
 
 #include <hwy/highway.h>
 #include <hwy/targets.h>

@@ -3,6 +3,7 @@
 #include "core/fork_join.hpp"
 
 #include <covrast/renderer.hpp>
+#include <covrast/tools.hpp>
 
 #include <oneapi/tbb/info.h>
 #include <oneapi/tbb/task_arena.h>

@@ -1,8 +1,8 @@
 // Post: transparent and skybox backgrounds (formulas in post/background.hpp).
 #include "post/background.hpp"
 
-#include "core/srgb.hpp"
-#include "core/srgb8.hpp"
+#include "color/srgb.hpp"
+#include "color/srgb8.hpp"
 
 #include <algorithm>
 #include <array>
@@ -35,7 +35,7 @@ std::uint8_t unit_code(double x) {
 
 SkyView::SkyView(const Scene& scene, int width_px, int height_px)
     : sky_(*scene.environment),
-      mapping_{ToneMapOperator(int(scene.tone_map)), scene.exposure},
+      mapping_{scene.tone_map, scene.exposure},
       orthographic_(scene.camera.orthographic),
       forward_(glm::normalize(scene.camera.target - scene.camera.eye)),
       right_(glm::normalize(glm::cross(forward_, scene.camera.up))),

@@ -19,8 +19,8 @@
 #include <covrast/image.hpp>
 #include <covrast/scene.hpp>
 
-#include "core/environment_lighting.hpp"
-#include "core/tone_map.hpp"
+#include "color/tone_map.hpp"
+#include "shading/environment_lighting.hpp"
 
 #include <glm/glm.hpp>
 

@@ -13,7 +13,7 @@
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
 
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 #include "post/fxaa_kernel.hpp"
 
 #include <algorithm>

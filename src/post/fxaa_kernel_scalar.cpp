@@ -1,9 +1,9 @@
 // Post-process stage, FXAA: the scalar twins of the row kernels (fxaa_kernel.hpp), one pixel
 // at a time. Written from the published description of FXAA 3.11 (fxaa.hpp, docs/fxaa.md).
-#include "core/srgb.hpp"
+#include "color/srgb.hpp"
 #include "post/fxaa_kernel.hpp"
 
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 
 #include <algorithm>
 #include <array>

@@ -1,7 +1,7 @@
 // Colour helpers of the scene format: the sRGB transfer function (IEC 61966-2-1) used to turn
 // the sRGB display values of scene files into linear light, and the per_triangle debug colour.
 #include <covrast/scene.hpp>
-#include "core/srgb.hpp"
+#include "color/srgb.hpp"
 
 #include <array>
 #include <cmath>

@@ -5,6 +5,7 @@
 #include "fuzz_support.hpp"
 
 #include <covrast/image.hpp>
+#include <covrast/tools.hpp>
 
 namespace {
 

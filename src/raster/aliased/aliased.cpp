@@ -8,12 +8,12 @@
 // - Shading is deferred: a pixel records which triangle last won its depth test, and
 //   end_tile shades each pixel once, for that triangle, at the same point (x + 0.5, y + 0.5):
 //   the colour the winning triangle would have written when it won.
-#include "core/shading.hpp"
-#include "core/srgb.hpp"
-#include "core/srgb8.hpp"
+#include "color/srgb.hpp"
+#include "color/srgb8.hpp"
 #include "core/tile_raster.hpp"
 #include "raster/aliased/aliased_kernel.hpp"
 #include "raster/rasterizers.hpp"
+#include "shading/shading.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -70,11 +70,11 @@ class AliasedRasterizer final : public TileRasterizer {
     const PixelRect r = intersect(touched_pixels(t), rect_);
     if (r.empty()) return;
     std::uint64_t id = std::uint64_t(here);
-    if (t.alpha_mode == TriangleAlpha::Blend) {
+    if (t.alpha_mode == AlphaMode::Blend) {
       blend_.push_back(&t);  // composited at the end of the tile, in depth order
       return;
     }
-    if (t.alpha_mode == TriangleAlpha::Mask) {
+    if (t.alpha_mode == AlphaMode::Mask) {
       raster_mask(t, r, id);
       return;
     }

@@ -3,8 +3,8 @@
 // back on are in abuffer_visibility.cpp.
 #include "raster/coverage/abuffer.hpp"
 
+#include "color/srgb8.hpp"
 #include "core/checks.hpp"
-#include "core/srgb8.hpp"
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 #include "raster/coverage/fragment_shading.hpp"

@@ -5,14 +5,14 @@
 //  - coverage:       the A-buffer (resolve/abuffer.hpp), which resolves it without seams;
 //  - coverage-blend: the literal seed, alpha-blended over the frame buffer with one depth
 //                    per pixel (kept to show what the A-buffer fixes).
-#include "core/shading.hpp"
-#include "core/srgb8.hpp"
+#include "color/srgb8.hpp"
 #include "core/testing_hooks.hpp"
 #include "core/tile_raster.hpp"
 #include "raster/coverage/abuffer.hpp"
 #include "raster/coverage/coverage_kernel.hpp"
 #include "raster/coverage/fragment_shading.hpp"
 #include "raster/rasterizers.hpp"
+#include "shading/shading.hpp"
 
 #include <algorithm>
 #include <bit>
@@ -62,13 +62,13 @@ class CoverageRasterizer final : public TileRasterizer {
       // and stacked copies cost one comparison each.
       // Only an opaque one hides the copy (a MASK or BLEND one may let it show).
       if (previous_ != nullptr && same_geometry(*previous_, t)) return;
-      if (t.alpha_mode == TriangleAlpha::Opaque) previous_ = &t;
+      if (t.alpha_mode == AlphaMode::Opaque) previous_ = &t;
     }
     bool skip_decided = false;
     // The fast paths are for opaque triangles: one whose every pixel would drop its fragment
     // as hidden (no kernel, no fragments: on dense meshes a quarter to two thirds of them),
     // and the tile and block paths for one covering the pixels entirely.
-    if (!blend_ && fast_paths_ && t.alpha_mode == TriangleAlpha::Opaque) {
+    if (!blend_ && fast_paths_ && t.alpha_mode == AlphaMode::Opaque) {
       if (abuffer_.hides_rect(t, r)) {
         ++hidden_draws_;
         return;
@@ -136,7 +136,7 @@ class CoverageRasterizer final : public TileRasterizer {
         const int lane = std::countr_zero(covered);
         const std::uint32_t coverage = row[lane];
         const int x = g + lane;
-        if (t.alpha_mode != TriangleAlpha::Opaque) {
+        if (t.alpha_mode != AlphaMode::Opaque) {
           alpha_fragment(t, x, y, coverage, column_z[lane] + row_z);
           continue;
         }
@@ -168,7 +168,7 @@ class CoverageRasterizer final : public TileRasterizer {
                       double centre_z) {
     if (!blend_) {
       const MaskVerdict verdict = mask_verdict(t, x, y);  // Keep for BLEND
-      if (t.alpha_mode == TriangleAlpha::Blend || verdict == MaskVerdict::Straddles) {
+      if (t.alpha_mode == AlphaMode::Blend || verdict == MaskVerdict::Straddles) {
         abuffer_.add_transparent(x, y, &t, coverage, centre_z);
       } else if (verdict == MaskVerdict::Keep) {
         abuffer_.add(x, y, &t, coverage, centre_z);
@@ -176,17 +176,17 @@ class CoverageRasterizer final : public TileRasterizer {
       return;
     }
     const double cx = x + 0.5, cy = y + 0.5;
-    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps(t, cx, cy, true)) return;
+    if (t.alpha_mode == AlphaMode::Mask && !mask_keeps(t, cx, cy, true)) return;
     const std::size_t i = std::size_t(y - rect_.y0) * tile_px_ + (x - rect_.x0);
     const float z = float(t.depth_at(cx, cy));
     if (!(z < depth_[i])) return;
     const ShadedColor c = shade_rgba(t, cx, cy, true);
     const float alpha =
         coverage_to_alpha8(coverage) / 255.0f *
-        (t.alpha_mode == TriangleAlpha::Blend ? float(std::clamp(c.alpha, 0.0, 1.0)) : 1.0f);
+        (t.alpha_mode == AlphaMode::Blend ? float(std::clamp(c.alpha, 0.0, 1.0)) : 1.0f);
     const glm::vec3 dst = color_[i].r < 0.0f ? background_ : color_[i];
     color_[i] = alpha * c.rgb + (1.0f - alpha) * dst;
-    if (t.alpha_mode == TriangleAlpha::Mask) depth_[i] = z;
+    if (t.alpha_mode == AlphaMode::Mask) depth_[i] = z;
   }
 
   static bool same_geometry(const TriangleSetup& a, const TriangleSetup& b) {

@@ -70,7 +70,7 @@ AlphaRange surface_alpha_range(const TriangleSetup& t, const double mu[3],
 }  // namespace
 
 MaskVerdict mask_verdict(const TriangleSetup& t, int x, int y) {
-  if (t.alpha_mode != TriangleAlpha::Mask) return MaskVerdict::Keep;
+  if (t.alpha_mode != AlphaMode::Mask) return MaskVerdict::Keep;
   const double cutoff = t.shading->surface->alpha_cutoff;
   double mu[3];
   perspective_weights(t, x + 0.5, y + 0.5, true, mu);
@@ -121,7 +121,7 @@ MaskShare mask_share(const TriangleSetup& t, int x, int y) {
 }
 
 ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
-  if (t.alpha_mode == TriangleAlpha::Mask && mask_verdict(t, x, y) == MaskVerdict::Straddles) {
+  if (t.alpha_mode == AlphaMode::Mask && mask_verdict(t, x, y) == MaskVerdict::Straddles) {
     const MaskShare share = mask_share(t, x, y);
     double mu[3];
     if (share.share > 0.0 && share.share < 1.0 &&
@@ -136,7 +136,7 @@ ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
     return {shade_fragment(t, x, y), share.share};
   }
   const glm::vec3 rgb = shade_fragment(t, x, y);
-  if (t.alpha_mode != TriangleAlpha::Blend) return {rgb, 1.0};
+  if (t.alpha_mode != AlphaMode::Blend) return {rgb, 1.0};
   double mu[3];
   perspective_weights(t, x + 0.5, y + 0.5, true, mu);
   return {rgb, surface_alpha(t, mu[0], mu[1], mu[2])};

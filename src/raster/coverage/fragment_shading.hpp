@@ -13,14 +13,14 @@
 // 256-sample supersampling was 29/255 and 10/255 off at worst.
 #pragma once
 
-#include "core/shading.hpp"
-#include "core/shading_inputs.hpp"
+#include "shading/shading.hpp"
+#include "shading/shading_inputs.hpp"
 
 namespace covrast::detail {
 
 /// The shading of a fragment of a textured surface: the clamped centre's weights for
 /// everything else, and for each texture its exact mean over the triangle's part of the pixel
-/// mapped into the texture, at the centre's level of detail (core/texture_sampling.hpp
+/// mapped into the texture, at the centre's level of detail (texture/texture_sampling.hpp
 /// area_average; the reference's and ssaa's samples use the level of the pixel's footprint
 /// too). Where that declines (a part over more than 64 texels of a level), the
 /// mean of the lookups at the points of a 4x4 grid of the pixel ((i + 1/2) / 4, as ssaa:4

@@ -2,9 +2,9 @@
 #include "raster/reference/reference.hpp"
 #include "raster/rasterizers.hpp"
 
+#include "color/srgb8.hpp"
 #include "core/edge_function.hpp"
-#include "core/shading.hpp"
-#include "core/srgb8.hpp"
+#include "shading/shading.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -103,7 +103,7 @@ void ReferenceRasterizer::resolve_tile(const FrameTarget&) {
       for (std::uint32_t k = row_begin_[row]; k < row_begin_[row + 1]; ++k) {
         const Pending& p = pending_[row_items_[k]];
         if (x < p.rect.x0 || x >= p.rect.x1) continue;
-        if (p.triangle->alpha_mode == TriangleAlpha::Blend) {
+        if (p.triangle->alpha_mode == AlphaMode::Blend) {
           blend_.push_back(row_items_[k]);  // composited after the opaque samples
         } else {
           sample_pixel(*p.triangle, row_items_[k], x, y);
@@ -198,7 +198,7 @@ glm::dvec3 ReferenceRasterizer::composite_pixel(int x, int y, double& nearest) {
 void ReferenceRasterizer::sample_pixel(const TriangleSetup& t, std::uint32_t index, int x, int y) {
   if (!inside_samples(t, x, y)) return;
   const std::size_t count = ox_.size();
-  if (t.alpha_mode == TriangleAlpha::Mask) {
+  if (t.alpha_mode == AlphaMode::Mask) {
     // Kept where the alpha at the sample passes the cutoff (a texture-driven edge, per sample).
     for (std::size_t s = 0; s < count; ++s) {
       if (inside_[s] != 0) inside_[s] = mask_keeps(t, x + ox_[s], y + oy_[s], false);

@@ -2,9 +2,9 @@
 // (sample_raster.hpp, sample_kernel.hpp).
 #include "raster/samples/sample_raster.hpp"
 
+#include "color/srgb8.hpp"
 #include "core/edge_function.hpp"
-#include "core/shading.hpp"
-#include "core/srgb8.hpp"
+#include "shading/shading.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -138,7 +138,7 @@ void SampleRasterizer::begin_tile(const PixelRect& rect, const FrameTarget& targ
 void SampleRasterizer::draw(const TriangleSetup& t) {
   const PixelRect r = intersect(touched_pixels(t), rect_);
   if (r.empty()) return;
-  if (t.alpha_mode == TriangleAlpha::Blend) {
+  if (t.alpha_mode == AlphaMode::Blend) {
     blend_.push_back(Pending{&t, r});  // composited per sample before the resolve
     return;
   }
@@ -228,7 +228,7 @@ void SampleRasterizer::rasterize(const TriangleSetup& t, const PixelRect& r) {
   }
   const std::size_t stride = std::size_t(gp.stride);
   // MASK triangles take the int64 path on every group: it tests the alpha sample by sample.
-  const bool mask = t.alpha_mode == TriangleAlpha::Mask;
+  const bool mask = t.alpha_mode == AlphaMode::Mask;
   if (fits && !mask) {
     job.rgb = flat_rgb;
     ShadeContext context{this, &t};
@@ -300,7 +300,7 @@ void SampleRasterizer::sample_wide(const TriangleSetup& t, const std::int64_t f[
     }
     const float z = z_base + tri_->dz[l];
     if (!inside || !(z < out.depth[l])) continue;
-    if (t.alpha_mode == TriangleAlpha::Mask && !mask_keeps_lane(t, gx, y, l)) continue;
+    if (t.alpha_mode == AlphaMode::Mask && !mask_keeps_lane(t, gx, y, l)) continue;
     out.depth[l] = z;
     if (rgb != nullptr) {
       out.r[l] = rgb[0];

@@ -1,6 +1,6 @@
 // The terms of the glTF 2.0 metallic-roughness BRDF (Specification, Appendix B.3) that both the
-// punctual lights (core/shading.cpp, pbr_brdf) and the environment's integrals
-// (core/environment_lighting.cpp) evaluate: one home, so both compute them with the same
+// punctual lights (shading/shading.cpp, pbr_brdf) and the environment's integrals
+// (shading/environment_lighting.cpp) evaluate: one home, so both compute them with the same
 // operations and get the same bits.
 #pragma once
 

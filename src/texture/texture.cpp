@@ -2,8 +2,8 @@
 // scene load (make_texture) and sampling it (texture_sampling.hpp), each texel decoded to
 // linear light by a 256-entry table. Double precision throughout, no contraction: the same
 // bits in every mode, tile, thread and compiler.
-#include "core/srgb.hpp"
-#include "core/texture_sampling.hpp"
+#include "color/srgb.hpp"
+#include "texture/texture_sampling.hpp"
 
 #include <covrast/error.hpp>
 

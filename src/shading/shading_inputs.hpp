@@ -6,9 +6,9 @@
 // The formulas are in docs/shading.md; all arithmetic is double, IEEE, no contraction.
 #pragma once
 
-#include "core/texture_sampling.hpp"
-#include "core/tone_map.hpp"
+#include "color/tone_map.hpp"
 #include "core/triangle_setup.hpp"
+#include "texture/texture_sampling.hpp"
 
 #include <covrast/texture.hpp>
 
@@ -18,9 +18,6 @@
 #include <vector>
 
 namespace covrast::detail {
-
-/// covrast::ShadingModel, mirrored here (core does not include the scene API).
-enum class LitModel : std::uint8_t { Unlit, Lambert, BlinnPhong, Pbr };
 
 /// A punctual light prepared for evaluation, world space.
 struct PunctualLight {
@@ -37,7 +34,7 @@ struct PunctualLight {
   double cone_offset = 1.0;
 };
 
-class EnvironmentLighting;  // core/environment_lighting.hpp
+class EnvironmentLighting;  // shading/environment_lighting.hpp
 
 /// The frame's lights and eye: one per front end, shared by every lit triangle.
 struct ShadingContext {
@@ -49,7 +46,7 @@ struct ShadingContext {
   std::vector<PunctualLight> lights;
   /// The scene's environment, prepared (null: none); lights every lit model but Unlit.
   const EnvironmentLighting* environment = nullptr;
-  /// Applied to each lit colour as it leaves shade_lit (core/tone_map.hpp).
+  /// Applied to each lit colour as it leaves shade_lit (color/tone_map.hpp).
   ToneMapping tone_mapping;
 };
 
@@ -89,7 +86,7 @@ struct FragmentFootprint {
 
 /// One material of one mesh instance, resolved (scene overrides applied).
 struct SurfaceShading {
-  LitModel model = LitModel::Lambert;
+  ShadingModel model = ShadingModel::Lambert;
   double metallic = 1.0;
   double roughness = 1.0;    ///< perceptual; the BRDF's alpha = roughness^2
   glm::dvec3 emissive{0.0};  ///< linear radiance, added
@@ -120,9 +117,9 @@ struct SurfaceShading {
   /// tangent towards the bitangent.
   double anisotropy = 0.0;
   glm::dvec2 anisotropy_rotation{1.0, 0.0};
-  bool anisotropic() const { return model == LitModel::Pbr && anisotropy > 0.0; }
+  bool anisotropic() const { return model == ShadingModel::Pbr && anisotropy > 0.0; }
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
-  TriangleAlpha alpha_mode = TriangleAlpha::Opaque;
+  AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
   double base_alpha = 1.0;    ///< the base colour factor's alpha
   const ShadingContext* context = nullptr;
@@ -153,7 +150,7 @@ struct ShadingRecord {
   const TexturedCorners* textured = nullptr;  ///< null unless surface->textures
 };
 
-/// The textures' contribution at one shading point (core/texture_shading.cpp).
+/// The textures' contribution at one shading point (shading/texture_shading.cpp).
 struct SurfaceSample {
   glm::dvec4 base_color{1.0};        ///< multiplies the base colour; alpha for the alpha modes
   double metallic = 1.0;             ///< the surface's, times the texture's B
@@ -181,7 +178,7 @@ struct SurfaceSample {
 /// the level of detail from the exact screen-space derivatives of each UV set there;
 /// `normal` is the interpolated unit normal (zero: none), which the normal map perturbs.
 /// With a `footprint`, each slot is its average over the fragment at the level
-/// of detail of mu0..mu2 (core/texture_shading.cpp, footprint_average).
+/// of detail of mu0..mu2 (shading/texture_shading.cpp, footprint_average).
 SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, double mu2,
                              const glm::dvec3& normal,
                              const FragmentFootprint* footprint = nullptr);
@@ -218,7 +215,7 @@ inline glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& b
   return shade_point(surface, base, p, n, n);
 }
 
-/// The pbr material at one shading point, its Fresnel terms prepared (core/shading.cpp):
+/// The pbr material at one shading point, its Fresnel terms prepared (shading/shading.cpp):
 /// c_diff = base (1 - metallic); F0 and F90 from KHR_materials_ior and _specular, lerped to the
 /// metal's (base, 1) by metallic; F0_d, the F0 the diffuse weight uses (the dielectric F0's
 /// largest channel, lerped alike; F0 itself when the dielectric F0 is grey).

@@ -3,7 +3,7 @@
 //
 // Outgoing radiance from the environment at a point with unit normal n and view v:
 //   L_o = integral over the sphere of f(l, v) L(l) max(0, n . l) dl
-// with f the glTF BRDF (Specification Appendix B.3.5, core/shading.cpp pbr_brdf):
+// with f the glTF BRDF (Specification Appendix B.3.5, shading/shading.cpp pbr_brdf):
 //   f = (1 - F) c_diff / pi + F D V,   F = f0 + (1 - f0) s,   s = (1 - |v . h|)^5,
 // which splits into four integrals that do not depend on the base colour:
 //   E   = int L (n.l)+           (irradiance)         E_s = int s L (n.l)+ / pi
@@ -154,5 +154,9 @@ class EnvironmentSky {
 /// From tables computed once per process by dense quadrature, interpolated bilinearly.
 /// Exposed for the tests.
 std::array<double, 3> uniform_environment_integrals(double mu, double roughness);
+
+/// The smallest n . v of the tables' first node (n . v = 0 has no reflection); a view below it
+/// is moved up to it before the tables are read.
+inline constexpr double kUniformTableMinMu = 1e-4;
 
 }  // namespace covrast::detail

@@ -17,20 +17,19 @@
 //                         (x (2.43 x + 0.59) + 0.14), 0, 1) of x = exposure x.
 #pragma once
 
+#include <covrast/shading.hpp>
+
 #include <glm/glm.hpp>
 
 #include <cstdint>
 
 namespace covrast::detail {
 
-/// covrast::ToneMap, mirrored (core does not include the scene API).
-enum class ToneMapOperator : std::uint8_t { None, KhronosPbrNeutral, AcesHill, AcesNarkowicz };
-
 struct ToneMapping {
-  ToneMapOperator op = ToneMapOperator::None;
+  ToneMap op = ToneMap::None;
   double exposure = 1.0;
   /// None at exposure 1 changes nothing: callers skip it so that the bytes stay as they were.
-  bool is_identity() const { return op == ToneMapOperator::None && exposure == 1.0; }
+  bool is_identity() const { return op == ToneMap::None && exposure == 1.0; }
 };
 
 glm::dvec3 tone_map(const ToneMapping& mapping, const glm::dvec3& linear);

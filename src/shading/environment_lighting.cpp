@@ -1,8 +1,9 @@
 // Image-based lighting: the moment pyramid for the irradiance, the radiance pyramid and the
-// filtered GGX estimates for the rest (the formulas are in core/environment_lighting.hpp).
-#include "core/environment_lighting.hpp"
+// filtered GGX estimates for the rest (the formulas are in shading/environment_lighting.hpp).
+#include "shading/environment_lighting.hpp"
 #include "core/fork_join.hpp"
-#include "core/pbr_terms.hpp"
+#include "shading/ggx_sampling.hpp"
+#include "shading/pbr_terms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -37,11 +38,6 @@ constexpr int kPrefilterFewest = 64;
 constexpr int kPrefilterMost = 1024;
 /// Added to the filtered-importance-sampling level (Krivanek and Colbert add 1).
 constexpr double kLodBias = 0.0;
-/// Uniform-light tables: n . v in [0, 1] and perceptual roughness in [0, 1], both at
-/// evenly spaced nodes; each entry from kTableSamples stratified directions.
-constexpr int kTableMuNodes = 64;
-constexpr int kTableRoughnessNodes = 32;
-constexpr int kTableSamples = 4096;
 /// A texel with at least this share of the map's power (luminance x solid angle) is a sun.
 constexpr double kSunPowerShare = 0.01;
 /// At most this many suns (the brightest); the rest stay in the map.
@@ -59,131 +55,6 @@ int floor_pow2(int n) {
   int p = 1;
   while (p * 2 <= n) p *= 2;
   return p;
-}
-
-/// Van der Corput radical inverse in base 2: the second Hammersley coordinate.
-double radical_inverse2(unsigned i) {
-  double inv = 0.5, r = 0.0;
-  while (i != 0) {
-    if ((i & 1U) != 0) r += inv;
-    inv *= 0.5;
-    i >>= 1U;
-  }
-  return r;
-}
-
-/// An orthonormal basis (t, b) around unit n: Duff et al., "Building an Orthonormal Basis,
-/// Revisited", JCGT 6(1), 2017.
-void tangent_frame(const glm::dvec3& n, glm::dvec3& t, glm::dvec3& b) {
-  const double sign = std::copysign(1.0, n.z);
-  const double a = -1.0 / (sign + n.z);
-  const double c = n.x * n.y * a;
-  t = glm::dvec3(1.0 + sign * n.x * n.x * a, sign * c, -sign * n.x);
-  b = glm::dvec3(c, sign + n.y * n.y * a, -n.y);
-}
-
-/// cos and sin of the azimuth 2 pi xi2 of the first `count` Hammersley points: the same for
-/// every shading point and roughness, so computed once.
-std::vector<glm::dvec2> hammersley_azimuths(int count) {
-  std::vector<glm::dvec2> azimuths;
-  for (int k = 0; k < count; ++k) {
-    const double phi = 2.0 * kPi * radical_inverse2(unsigned(k));
-    azimuths.push_back({std::cos(phi), std::sin(phi)});
-  }
-  return azimuths;
-}
-
-/// The half vector of GGX sample (xi1, azimuth) around n: cos(theta_h) = sqrt((1 - xi1) / (1 +
-/// (alpha^2 - 1) xi1)) samples D(h) (n . h) (Walter et al. 2007, eq. 35).
-glm::dvec3 ggx_half_vector(double xi1, const glm::dvec2& azimuth, double alpha2,
-                           const glm::dvec3& n, const glm::dvec3& t, const glm::dvec3& b,
-                           double& cos_h) {
-  cos_h = std::sqrt((1.0 - xi1) / (1.0 + (alpha2 - 1.0) * xi1));
-  const double sin_h = std::sqrt(std::max(0.0, 1.0 - cos_h * cos_h));
-  return t * (sin_h * azimuth.x) + b * (sin_h * azimuth.y) + n * cos_h;
-}
-
-/// V = 1 / (g(n.l) g(n.v)), the specification's height-correlated Smith term, for n.l,
-/// n.v > 0.
-double smith_visibility(double n_dot_l, double n_dot_v, double alpha2) {
-  return 1.0 / (smith_g(n_dot_l, alpha2) * smith_g(n_dot_v, alpha2));
-}
-
-/// The view direction with n . v = mu in the (x, z) plane of n = +Z.
-glm::dvec3 view_at(double mu) { return {std::sqrt(std::max(0.0, 1.0 - mu * mu)), 0.0, mu}; }
-
-struct UniformTables {
-  std::vector<double> schlick_diffuse;   ///< [mu]: int s (n.l)+ dl / pi
-  std::vector<double> specular;          ///< [r][mu]: int D V (n.l)+ dl
-  std::vector<double> specular_schlick;  ///< [r][mu]: int s D V (n.l)+ dl
-};
-
-/// The smallest n . v of the tables' first node (n . v = 0 has no reflection).
-constexpr double kTableMinMu = 1e-4;
-
-double table_mu(int i) { return std::max(kTableMinMu, double(i) / double(kTableMuNodes - 1)); }
-
-UniformTables build_uniform_tables() {
-  UniformTables tables;
-  tables.schlick_diffuse.resize(kTableMuNodes);
-  tables.specular.resize(std::size_t(kTableMuNodes) * kTableRoughnessNodes);
-  tables.specular_schlick.resize(tables.specular.size());
-  const glm::dvec3 n(0.0, 0.0, 1.0), t(1.0, 0.0, 0.0), b(0.0, 1.0, 0.0);
-  const std::vector<glm::dvec2> azimuths = hammersley_azimuths(kTableSamples);
-  // The GGX half vectors of each roughness node (they do not depend on the view), with
-  // n . h in w.
-  std::vector<std::vector<glm::dvec4>> half_vectors(kTableRoughnessNodes);
-  for (int j = 0; j < kTableRoughnessNodes; ++j) {
-    const double r = double(j) / double(kTableRoughnessNodes - 1);
-    const double alpha = std::max(r * r, kMinBrdfAlpha);
-    for (int k = 0; k < kTableSamples; ++k) {
-      double cos_h = 0.0;
-      const glm::dvec3 h = ggx_half_vector((k + 0.5) / kTableSamples, azimuths[std::size_t(k)],
-                                           alpha * alpha, n, t, b, cos_h);
-      half_vectors[std::size_t(j)].push_back(glm::dvec4(h, cos_h));
-    }
-  }
-  for (int i = 0; i < kTableMuNodes; ++i) {
-    const double mu = table_mu(i);
-    const glm::dvec3 v = view_at(mu);
-    // Cosine-distributed l (pdf (n.l) / pi): int s (n.l)+ dl / pi = mean of s.
-    double s_sum = 0.0;
-    for (int k = 0; k < kTableSamples; ++k) {
-      const double xi1 = (k + 0.5) / kTableSamples;
-      const double sin_l = std::sqrt(xi1), cos_l = std::sqrt(1.0 - xi1);
-      const glm::dvec2& azimuth = azimuths[std::size_t(k)];
-      const glm::dvec3 l(sin_l * azimuth.x, sin_l * azimuth.y, cos_l);
-      const glm::dvec3 h = glm::normalize(l + v);
-      s_sum += schlick_weight(std::abs(glm::dot(v, h)));
-    }
-    tables.schlick_diffuse[std::size_t(i)] = s_sum / kTableSamples;
-    for (int j = 0; j < kTableRoughnessNodes; ++j) {
-      const double r = double(j) / double(kTableRoughnessNodes - 1);
-      const double alpha = std::max(r * r, kMinBrdfAlpha), alpha2 = alpha * alpha;
-      double a_sum = 0.0, b_sum = 0.0;
-      for (const glm::dvec4& sample : half_vectors[std::size_t(j)]) {
-        const glm::dvec3 h(sample);
-        const double cos_h = sample.w;
-        const double v_dot_h = glm::dot(v, h);
-        if (!(v_dot_h > 0.0)) continue;
-        const glm::dvec3 l = h * (2.0 * v_dot_h) - v;
-        if (!(l.z > 0.0)) continue;
-        // f cos / pdf with pdf(l) = D (n.h) / (4 v.h): V (n.l) 4 (v.h) / (n.h).
-        const double w = smith_visibility(l.z, mu, alpha2) * l.z * 4.0 * v_dot_h / cos_h;
-        a_sum += w;
-        b_sum += w * schlick_weight(v_dot_h);
-      }
-      const std::size_t at = std::size_t(j) * kTableMuNodes + std::size_t(i);
-      tables.specular[at] = a_sum / kTableSamples;
-      tables.specular_schlick[at] = b_sum / kTableSamples;
-    }
-  }
-  return tables;
-}
-
-const UniformTables& uniform_tables() {
-  static const UniformTables tables = build_uniform_tables();  // thread-safe, once
-  return tables;
 }
 
 /// Bilinear interpolation of an equirectangular grid of `width` x `height` values (texel
@@ -260,26 +131,6 @@ glm::dvec3 EnvironmentSky::radiance(const glm::dvec3& d_world) const {
   return equirect_bilinear(map_->radiance_linear, map_->width, map_->height,
                            environment_uv(d_map)) *
          intensity_;
-}
-
-std::array<double, 3> uniform_environment_integrals(double mu, double roughness) {
-  const UniformTables& tables = uniform_tables();
-  const double x = std::clamp(mu, 0.0, 1.0) * (kTableMuNodes - 1);
-  const double y = std::clamp(roughness, 0.0, 1.0) * (kTableRoughnessNodes - 1);
-  const int i0 = std::min(int(x), kTableMuNodes - 2),
-            j0 = std::min(int(y), kTableRoughnessNodes - 2);
-  const double fx = x - i0, fy = y - j0;
-  auto at = [&](const std::vector<double>& table, int i, int j) {
-    return table[std::size_t(j) * kTableMuNodes + std::size_t(i)];
-  };
-  auto bilerp = [&](const std::vector<double>& table) {
-    const double top = at(table, i0, j0) * (1.0 - fx) + at(table, i0 + 1, j0) * fx;
-    const double bottom = at(table, i0, j0 + 1) * (1.0 - fx) + at(table, i0 + 1, j0 + 1) * fx;
-    return top * (1.0 - fy) + bottom * fy;
-  };
-  const double s = tables.schlick_diffuse[std::size_t(i0)] * (1.0 - fx) +
-                   tables.schlick_diffuse[std::size_t(i0 + 1)] * fx;
-  return {s, bilerp(tables.specular), bilerp(tables.specular_schlick)};
 }
 
 EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
@@ -581,9 +432,9 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
   // A view at or below the shading horizon (normal maps, interpolated normals): moved to just
   // above it, as the BRDF's |n . v| would see it.
   double mu = glm::dot(n, v);
-  if (mu < kTableMinMu) {
-    v = glm::normalize(v + n * (kTableMinMu - mu));
-    mu = std::max(glm::dot(n, v), kTableMinMu);
+  if (mu < kUniformTableMinMu) {
+    v = glm::normalize(v + n * (kUniformTableMinMu - mu));
+    mu = std::max(glm::dot(n, v), kUniformTableMinMu);
   }
   const std::array<double, 3> uniform = uniform_environment_integrals(mu, roughness);
   out.irradiance_schlick = out.irradiance * (uniform[0] / kPi);

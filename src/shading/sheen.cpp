@@ -1,5 +1,5 @@
-// KHR_materials_sheen's BRDF and its albedo table (core/sheen.hpp).
-#include "core/sheen.hpp"
+// KHR_materials_sheen's BRDF and its albedo table (shading/sheen.hpp).
+#include "shading/sheen.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,9 +3,9 @@
 // exact screen-space derivatives (below) for the level of detail, KHR_texture_transform,
 // and what each glTF slot does with its texel. Every mode reaches this through shade_lit,
 // so a point is textured alike in every mode, tile and thread.
-#include "core/shading.hpp"
-#include "core/shading_inputs.hpp"
-#include "core/texture_sampling.hpp"
+#include "shading/shading.hpp"
+#include "shading/shading_inputs.hpp"
+#include "texture/texture_sampling.hpp"
 
 #include <cmath>
 

@@ -13,9 +13,9 @@ struct FragmentFootprint;
 
 /// The lit colour of `t` at the perspective-correct barycentric weights mu0..mu2 (summing
 /// to 1): base colour, position and normal interpolated with them (the normal renormalised),
-/// then the material's lighting (core/shading.cpp). Out of line: it is the slow path.
+/// then the material's lighting (shading/shading.cpp). Out of line: it is the slow path.
 /// `footprint`: where the textures are averaged (sample_surface,
-/// core/shading_inputs.hpp).
+/// shading/shading_inputs.hpp).
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
                     const FragmentFootprint* footprint = nullptr);
 
@@ -70,7 +70,7 @@ inline glm::vec3 shade(const TriangleSetup& t, double x_px, double y_px, bool cl
 /// Alpha of a non-opaque triangle (it has a ShadingRecord) at the perspective-correct
 /// weights mu0..mu2: the one place where alpha is made (docs/transparency.md),
 ///   alpha = base_alpha x (mu0 a0 + mu1 a1 + mu2 a2) x texture alpha (1 until textures),
-/// a_i the vertex alphas (COLOR_0's fourth component). Out of line (core/shading.cpp).
+/// a_i the vertex alphas (COLOR_0's fourth component). Out of line (shading/shading.cpp).
 double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2);
 /// The same with the base colour texture's alpha given (`texture_alpha`, 1 without one).
 double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double mu2,

@@ -1,5 +1,5 @@
-// The tone-mapping operators of core/tone_map.hpp, each as its source publishes it.
-#include "core/tone_map.hpp"
+// The tone-mapping operators of color/tone_map.hpp, each as its source publishes it.
+#include "color/tone_map.hpp"
 
 #include <algorithm>
 
@@ -45,13 +45,13 @@ double narkowicz(double x) {
 glm::dvec3 tone_map(const ToneMapping& mapping, const glm::dvec3& linear) {
   const glm::dvec3 x = linear * mapping.exposure;
   switch (mapping.op) {
-    case ToneMapOperator::KhronosPbrNeutral:
+    case ToneMap::KhronosPbrNeutral:
       return khronos_pbr_neutral(x);
-    case ToneMapOperator::AcesHill:
+    case ToneMap::AcesHill:
       return aces_hill(x);
-    case ToneMapOperator::AcesNarkowicz:
+    case ToneMap::AcesNarkowicz:
       return {narkowicz(x.r), narkowicz(x.g), narkowicz(x.b)};
-    case ToneMapOperator::None:
+    case ToneMap::None:
     default:
       return x;
   }

@@ -1,7 +1,7 @@
-// KHR_materials_iridescence's thin-film Fresnel term (core/iridescence.hpp).
-#include "core/iridescence.hpp"
+// KHR_materials_iridescence's thin-film Fresnel term (shading/iridescence.hpp).
+#include "shading/iridescence.hpp"
 
-#include "core/pbr_terms.hpp"
+#include "shading/pbr_terms.hpp"
 
 #include <algorithm>
 #include <cmath>

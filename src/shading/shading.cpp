@@ -1,14 +1,14 @@
 // Lighting of lit triangles (docs/shading.md): the light models of covrast::ShadingModel
 // evaluated at one point, in double precision. Every raster mode reaches this through
-// shade() (core/shading.hpp), so all modes light a point alike; only where they evaluate
+// shade() (shading/shading.hpp), so all modes light a point alike; only where they evaluate
 // differs (pixel centre clamped into the triangle for coverage and msaa, every sample for
 // ssaa and reference).
-#include "core/shading.hpp"
-#include "core/environment_lighting.hpp"
-#include "core/iridescence.hpp"
-#include "core/pbr_terms.hpp"
-#include "core/shading_inputs.hpp"
-#include "core/sheen.hpp"
+#include "shading/shading.hpp"
+#include "shading/environment_lighting.hpp"
+#include "shading/iridescence.hpp"
+#include "shading/pbr_terms.hpp"
+#include "shading/shading_inputs.hpp"
+#include "shading/sheen.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -86,7 +86,7 @@ glm::dvec3 mirror_normal(const PbrPoint& m, const glm::dvec3& n, const glm::dvec
   return bent_length > 0.0 ? bent / bent_length : n;
 }
 
-/// The environment's light for the glTF BRDF (core/environment_lighting.hpp), with
+/// The environment's light for the glTF BRDF (shading/environment_lighting.hpp), with
 /// F = F0 + (F90 - F0) s:
 ///   occlusion x (c_diff ((1 - F0_d) E / pi - (F90 - F0_d) E_s) + F0 A + (F90 - F0) B),
 /// which for F90 = 1 and F0_d = F0 (the core material) is computed as
@@ -188,7 +188,7 @@ glm::dvec3 clearcoat_radiance(const SurfaceShading& s, const PbrPoint& m, const 
   return sum;
 }
 
-/// KHR_materials_sheen's layer (core/sheen.hpp): sheenColor x (sum_i D V E_i (n . l_i)+ plus
+/// KHR_materials_sheen's layer (shading/sheen.hpp): sheenColor x (sum_i D V E_i (n . l_i)+ plus
 /// the ambient light and the environment (without its suns, lit as the directional lights they
 /// are) each times the sheen's albedo E(n . v) and occlusion): the environment's cosine-
 /// weighted mean radiance E_env(n) / pi stands for the radiance the broad sheen lobe gathers,
@@ -353,16 +353,16 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
   glm::dvec3 v = eye_distance > 0.0 ? to_eye * (1.0 / eye_distance) : n;
   if (c.orthographic) v = c.to_eye;
   switch (s.model) {
-    case LitModel::Unlit:
+    case ShadingModel::Unlit:
       return base;
-    case LitModel::Lambert:
+    case ShadingModel::Lambert:
       return diffuse_sum(c, s.occlusion, base, p, n) +
              environment_diffuse(c, s.occlusion, base, n) + s.emissive;
-    case LitModel::BlinnPhong:
+    case ShadingModel::BlinnPhong:
       return diffuse_sum(c, s.occlusion, base, p, n) +
              environment_diffuse(c, s.occlusion, base, n) + blinn_phong_highlights(s, p, n, v) +
              s.emissive;
-    case LitModel::Pbr:
+    case ShadingModel::Pbr:
     default: {
       PbrPoint m(s, base, clearcoat_normal);
       if (s.anisotropy > 0.0) m.set_anisotropy(s.anisotropy, anisotropy_direction, n);
@@ -389,14 +389,14 @@ double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double
 
 ShadedColor shade_rgba(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
   const glm::vec3 rgb = shade(t, x_px, y_px, clamp_inside);
-  if (t.alpha_mode == TriangleAlpha::Opaque) return {rgb, 1.0};
+  if (t.alpha_mode == AlphaMode::Opaque) return {rgb, 1.0};
   double mu[3];
   perspective_weights(t, x_px, y_px, clamp_inside, mu);
   return {rgb, surface_alpha(t, mu[0], mu[1], mu[2])};
 }
 
 bool mask_keeps(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
-  if (t.alpha_mode != TriangleAlpha::Mask) return true;
+  if (t.alpha_mode != AlphaMode::Mask) return true;
   double mu[3];
   perspective_weights(t, x_px, y_px, clamp_inside, mu);
   return surface_alpha(t, mu[0], mu[1], mu[2]) >= t.shading->surface->alpha_cutoff;
@@ -421,7 +421,7 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
     return glm::vec3(mapping.is_identity() ? radiance : tone_map(mapping, radiance));
   };
   if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n, n));
-  // Textured: the surface with this point's texels (core/texture_shading.cpp).
+  // Textured: the surface with this point's texels (shading/texture_shading.cpp).
   const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n, footprint);
   SurfaceShading s = *r.surface;
   s.metallic = sample.metallic;

@@ -1,4 +1,4 @@
-// Core: the sRGB transfer functions of IEC 61966-2-1, in double. The one home of both
+// Colour: the sRGB transfer functions of IEC 61966-2-1, in double. The one home of both
 // formulas: every table and conversion of covrast (colour parsing, texture decoding, the
 // 8-bit encoder's thresholds, the blends of the aliased mode and FXAA, image comparison) is
 // built from these, so that they agree bit for bit.

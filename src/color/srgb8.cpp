@@ -1,8 +1,6 @@
 // Resolve stage: sRGB encoding and tile copy-out; see srgb8.hpp.
-#include "core/srgb8.hpp"
-#include "core/srgb.hpp"
-
-#include <covrast/scene.hpp>
+#include "color/srgb8.hpp"
+#include "color/srgb.hpp"
 
 #include <array>
 #include <cmath>
