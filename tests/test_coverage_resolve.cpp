@@ -159,13 +159,18 @@ covrast::RenderResult render(const Scene& s, ModeKind mode, int threads = 1, int
 }
 
 /// The screen triangles the renderer rasterises (its own geometry stage), for the reference.
+/// Unlit scenes only: their triangles point at no shading record, so they outlive the chunks'.
 std::vector<TriangleSetup> screen_triangles(const Scene& s) {
   covrast::detail::GeometryFrontEnd fe(s, s.width, s.height);
   for (std::size_t i = 0; i < fe.instance_count(); ++i)
     fe.transform_vertices(i, 0, fe.vertex_count(i));
   std::vector<TriangleSetup> tris;
   covrast::detail::SetupCounters counters;
-  for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) fe.setup_chunk(c, tris, counters);
+  covrast::detail::ChunkShading shading;
+  for (std::uint32_t c = 0; c < fe.chunk_count(); ++c) {
+    fe.setup_chunk(c, tris, shading, counters);
+    REQUIRE(shading.records.size() == 0);
+  }
   return tris;
 }
 

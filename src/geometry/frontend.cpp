@@ -70,16 +70,16 @@ GeometryFrontEnd::GeometryFrontEnd(const Scene& scene, int width_px, int height_
 }
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
-                                   SetupCounters& counters) const {
+                                   ChunkShading& shading, SetupCounters& counters) const {
   Sink sink{&out, nullptr, nullptr, counters};
-  setup_range(chunk, sink);
+  setup_range(chunk, shading, sink);
 }
 
 void GeometryFrontEnd::setup_chunk(std::uint32_t chunk, ChunkSetups& out,
                                    std::vector<PixelBounds16>& bounds,
                                    SetupCounters& counters) const {
   Sink sink{nullptr, &out, &bounds, counters};
-  setup_range(chunk, sink);
+  setup_range(chunk, out.shading(), sink);
 }
 
 // Inlined into setup_range's loop: as a call it spilled its arguments and the caller's
@@ -132,14 +132,14 @@ void GeometryFrontEnd::emit_clipped(std::size_t instance, const glm::dmat4& mvp,
   }
 }
 
-void GeometryFrontEnd::setup_range(std::uint32_t chunk, Sink& sink) const {
+void GeometryFrontEnd::setup_range(std::uint32_t chunk, ChunkShading& shading, Sink& sink) const {
   const std::uint64_t first = std::uint64_t(chunk) * kTrianglesPerChunk;
   const std::uint64_t last = std::min<std::uint64_t>(first + kTrianglesPerChunk, triangle_count());
-  if (!chunk_shading_.empty()) {
-    chunk_shading_[chunk].clear();
-    sink.shading = &chunk_shading_[chunk];
-    chunk_textured_[chunk].clear();
-    sink.textured = &chunk_textured_[chunk];
+  if (lit_context_) {
+    shading.records.clear();
+    sink.shading = &shading.records;
+    shading.textured.clear();
+    sink.textured = &shading.textured;
   }
   // The instance holding `first`: first_triangle_ is sorted, find the last entry <= first.
   std::size_t instance =

@@ -89,44 +89,6 @@ class HugePageBuffer {
   std::size_t bytes_ = 0;
 };
 
-/// One chunk's set-up triangles as the pipeline keeps them: written into the chunk's fixed
-/// slice of a frame-wide buffer (room for one triangle per input triangle, enough unless
-/// clipping splits triangles), and moved to an own, growing array if the slice runs full.
-/// Without a slice (reset(nullptr, 0), or as constructed) it is a plain growing array.
-class ChunkSetups {
- public:
-  /// Starts over, writing to `slice` (room for `capacity` triangles).
-  void reset(TriangleSetup* slice, std::size_t capacity) {
-    data_ = slice;
-    capacity_ = capacity;
-    size_ = 0;
-  }
-  /// A new triangle at the end, its fields to be written.
-  TriangleSetup& emplace_back() { return size_ < capacity_ ? data_[size_++] : grow(); }
-  std::size_t size() const { return size_; }
-  const TriangleSetup* data() const { return data_; }
-  const TriangleSetup& operator[](std::size_t i) const { return data_[i]; }
-
- private:
-  TriangleSetup& grow();
-
-  TriangleSetup* data_ = nullptr;
-  std::size_t size_ = 0;
-  std::size_t capacity_ = 0;
-  std::unique_ptr<TriangleSetup[]> overflow_;  ///< data_ once the slice ran full
-};
-
-/// A lit triangle's vertex as shading needs it: world position and unit normal (or any
-/// length after clipping; shade() renormalises after interpolation).
-struct ShadeVertex {
-  glm::vec3 position_world;
-  glm::vec3 normal_world;
-  /// Textured triangles only (TexturedCorners): both UV sets and the world tangent.
-  glm::vec2 uv[kMaxTexcoordSets];
-  glm::vec4 tangent_world;
-  float alpha = 1.0f;  ///< the vertex alpha (MeshData::color_alphas), for non-opaque surfaces
-};
-
 /// One chunk's ShadingRecords (or TexturedCorners): fixed blocks, so a record's address
 /// (TriangleSetup::shading) stays valid while more are added; the blocks are kept from frame
 /// to frame.
@@ -148,6 +110,55 @@ class RecordArena {
 };
 using ShadingArena = RecordArena<ShadingRecord>;
 using TexturedArena = RecordArena<TexturedCorners>;
+
+/// The shading inputs of one chunk's lit and textured triangles, which their TriangleSetup's
+/// `shading` points into: owned with the chunk's triangles (ChunkSetups, the pipeline's
+/// per-frame memory), written only while the chunk is set up, kept until it is set up again.
+struct ChunkShading {
+  ShadingArena records;
+  TexturedArena textured;
+};
+
+/// One chunk's set-up triangles as the pipeline keeps them: written into the chunk's fixed
+/// slice of a frame-wide buffer (room for one triangle per input triangle, enough unless
+/// clipping splits triangles), and moved to an own, growing array if the slice runs full.
+/// Without a slice (reset(nullptr, 0), or as constructed) it is a plain growing array.
+class ChunkSetups {
+ public:
+  /// Starts over, writing to `slice` (room for `capacity` triangles).
+  void reset(TriangleSetup* slice, std::size_t capacity) {
+    data_ = slice;
+    capacity_ = capacity;
+    size_ = 0;
+  }
+  /// A new triangle at the end, its fields to be written.
+  TriangleSetup& emplace_back() { return size_ < capacity_ ? data_[size_++] : grow(); }
+  std::size_t size() const { return size_; }
+  const TriangleSetup* data() const { return data_; }
+  const TriangleSetup& operator[](std::size_t i) const { return data_[i]; }
+  /// Where the chunk's shading records go (setup_chunk starts them over; reset() keeps them).
+  ChunkShading& shading() { return shading_; }
+
+ private:
+  TriangleSetup& grow();
+
+  TriangleSetup* data_ = nullptr;
+  std::size_t size_ = 0;
+  std::size_t capacity_ = 0;
+  std::unique_ptr<TriangleSetup[]> overflow_;  ///< data_ once the slice ran full
+  ChunkShading shading_;
+};
+
+/// A lit triangle's vertex as shading needs it: world position and unit normal (or any
+/// length after clipping; shade() renormalises after interpolation).
+struct ShadeVertex {
+  glm::vec3 position_world;
+  glm::vec3 normal_world;
+  /// Textured triangles only (TexturedCorners): both UV sets and the world tangent.
+  glm::vec2 uv[kMaxTexcoordSets];
+  glm::vec4 tangent_world;
+  float alpha = 1.0f;  ///< the vertex alpha (MeshData::color_alphas), for non-opaque surfaces
+};
 
 struct SetupCounters {
   std::uint64_t culled = 0;           ///< outside the view volume, zero area after snapping, or a
@@ -195,14 +206,14 @@ class GeometryFrontEnd {
   /// lit path's per-material loop, and its non-opaque ones get a ShadingRecord for alpha.
   bool instance_alpha(std::size_t instance) const { return !alpha_.empty() && alpha_[instance]; }
 
-  /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order. The
-  /// ShadingRecords of its lit triangles live in the front end until the same chunk is set up
-  /// again.
-  void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out,
+  /// Clips, snaps and sets up the triangles of one chunk, appending to `out` in order, and
+  /// their shading records to `shading` (started over), which must outlive their use.
+  void setup_chunk(std::uint32_t chunk, std::vector<TriangleSetup>& out, ChunkShading& shading,
                    SetupCounters& counters) const;
   /// The same into a ChunkSetups (the pipeline's form, started over with reset() by the
-  /// caller), and appends each emitted triangle's touched pixels clamped to the image to
-  /// `bounds` (for binning).
+  /// caller; the records go to its shading()), and appends each emitted triangle's touched
+  /// pixels clamped to the image to `bounds` (for binning). A const function: the front end
+  /// holds nothing of a frame, so chunks set up on several threads share it safely.
   void setup_chunk(std::uint32_t chunk, ChunkSetups& out, std::vector<PixelBounds16>& bounds,
                    SetupCounters& counters) const;
 
@@ -276,7 +287,7 @@ class GeometryFrontEnd {
   /// set_up_triangle gave its vertices (`front`: v1 and v2 swapped), linked from `t`.
   void set_up_shading(const ShadeVertex* shade, const SurfaceShading& lit, const LazyShade* lazy,
                       bool front, Sink& sink, TriangleSetup& t) const;
-  void setup_range(std::uint32_t chunk, Sink& sink) const;
+  void setup_range(std::uint32_t chunk, ChunkShading& shading, Sink& sink) const;
   /// The triangles [g, end) of a lit instance (setup_range's loop with shading inputs).
   void setup_lit_run(std::size_t instance, std::uint64_t g, std::uint64_t end, Sink& sink) const;
   /// The three ShadeVertex of triangle `local` of a lit instance (`normal_matrix`: the
@@ -324,8 +335,7 @@ class GeometryFrontEnd {
   bool cull_hidden_backfaces_;
   glm::dvec3 eye_;  ///< the camera position the view matrix was built from [world]
   // Lighting (empty for unlit scenes). surfaces_[i][m]: instance i's material
-  // m, pointing at context_; chunk_shading_[c]: the records of chunk c, written
-  // only by setup_chunk(c).
+  // m, pointing at context_.
   ShadingContext context_;
   std::optional<EnvironmentLighting> environment_;  ///< context_.environment points here
   bool lit_context_ = false;                        ///< prepare_lighting ran
@@ -341,8 +351,6 @@ class GeometryFrontEnd {
   std::vector<std::vector<SurfaceTextures>> textures_;
   std::vector<bool> lit_;
   std::vector<bool> alpha_;
-  mutable std::vector<ShadingArena> chunk_shading_;
-  mutable std::vector<TexturedArena> chunk_textured_;
 };
 
 }  // namespace covrast::detail

@@ -186,8 +186,6 @@ void GeometryFrontEnd::prepare_lighting() {
     if (surfaces_[i].empty()) surfaces_[i].push_back(surface_shading(Material{}, &context_));
     if (lit_[i]) vertices_[i].position_world.resize(scene_.meshes[i].mesh->positions.size());
   }
-  chunk_shading_.resize(chunk_count());
-  chunk_textured_.resize(chunk_count());
 }
 
 void GeometryFrontEnd::shade_vertices(std::size_t instance, std::size_t local,
