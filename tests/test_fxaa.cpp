@@ -276,22 +276,20 @@ void add_mesh(Scene& scene, std::vector<glm::vec3> positions, std::vector<std::u
   scene.meshes.push_back(std::move(instance));
 }
 
-/// Random overlapping triangles at random depths, one colour each.
+/// Random overlapping triangles at random depths, one colour each (the per-triangle debug
+/// colours).
 Scene random_triangles_scene() {
   Scene scene = pixel_scene(300, 200);
   std::mt19937 rng(1616);
-  std::uniform_real_distribution<float> x(-160.0f, 160.0f), y(-110.0f, 110.0f), z(-50.0f, 0.0f),
-      c(0.0f, 1.0f);
-  std::vector<glm::vec3> positions, colours;
+  std::uniform_real_distribution<float> x(-160.0f, 160.0f), y(-110.0f, 110.0f), z(-50.0f, 0.0f);
+  std::vector<glm::vec3> positions;
   std::vector<std::uint32_t> indices;
   for (std::uint32_t t = 0; t < 60; ++t) {
     const float depth = z(rng);
     for (int k = 0; k < 3; ++k) positions.emplace_back(x(rng), y(rng), depth);
     for (std::uint32_t k = 0; k < 3; ++k) indices.push_back(3 * t + k);
-    colours.emplace_back(c(rng), c(rng), c(rng));
   }
-  add_mesh(scene, std::move(positions), std::move(indices), ColorSource::PerTriangle,
-           std::move(colours));
+  add_mesh(scene, std::move(positions), std::move(indices), ColorSource::PerTriangle, {});
   return scene;
 }
 

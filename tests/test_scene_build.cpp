@@ -127,6 +127,34 @@ TEST_CASE("scene build: make_mesh analyses the mesh and converts colours to line
   covrast::check_scene(scene);
 }
 
+TEST_CASE("scene build: check_scene refuses a closed mesh whose analysis no longer holds",
+          "[scene_build]") {
+  auto mesh = std::make_shared<covrast::MeshData>(*covrast::make_mesh(cube()));
+  covrast::Scene scene = empty_scene(8, 8);
+  covrast::add_instance(scene, mesh);
+  covrast::add_instance(scene, mesh);  // two instances of one mesh: one message, the first
+  covrast::check_scene(scene);
+  REQUIRE(mesh->closed_orientation == 1);
+  REQUIRE(mesh->convex);
+
+  SECTION("a corner moved outwards changes the bounds") {
+    mesh->positions[0] = glm::vec3(-1.5f, -1.0f, -1.0f);
+  }
+  SECTION("a corner moved to the centre keeps the bounds and the closure, not convexity") {
+    mesh->positions[0] = glm::vec3(0.0f);
+  }
+  CHECK_THROWS_WITH(covrast::check_scene(scene),
+                    Contains("meshes[0] (cube)") && Contains("call analyze_mesh_topology again"));
+#if !defined(NDEBUG) || defined(COVRAST_CHECKS)
+  // Where covrast checks its invariants, the renderer checks the scene's precondition too.
+  CHECK_THROWS_WITH(covrast::render(scene, covrast::RenderOptions{}),
+                    Contains("call analyze_mesh_topology again"));
+#endif
+  covrast::analyze_mesh_topology(*mesh);
+  covrast::check_scene(scene);
+  CHECK(mesh->closed_orientation == 1);
+}
+
 TEST_CASE("scene build: a scene built in memory renders byte-identically to its JSON + OBJ twin",
           "[scene_build]") {
   const covrast::test::TempDir dir("covrast-test-scene-build");

@@ -34,9 +34,11 @@ class Renderer {
   /// Throws InputError for bad options (size, tile, mode parameters).
   /// The Renderer keeps a reference to `scene`, not a copy: the scene must outlive it and stay
   /// unchanged while it exists (meshes, instances, textures, environment). It does not
-  /// validate the scene (check_scene is O(triangles)): load_scene and load_mesh_scene give
-  /// valid scenes; for a scene built in code call check_scene first, since here an index out
-  /// of range or arrays whose sizes do not match are undefined behaviour.
+  /// validate the scene in release builds (check_scene is O(triangles)): load_scene and
+  /// load_mesh_scene give valid scenes; for a scene built in code call check_scene first,
+  /// since here an index out of range or arrays whose sizes do not match are undefined
+  /// behaviour. Debug builds and builds with COVRAST_CHECKS call check_scene here and throw
+  /// its InputError.
   Renderer(const Scene& scene, const RenderOptions& options);
   ~Renderer();
   Renderer(const Renderer&) = delete;

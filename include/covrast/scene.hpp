@@ -223,7 +223,8 @@ struct MeshData {
   glm::vec3 bounds_min{0.0f};  ///< object-space box of the vertices the triangles use
   glm::vec3 bounds_max{0.0f};
   /// triangle_count() when analysed: the renderer ignores closed_orientation if the indices
-  /// changed since (re-run analyze_mesh_topology after editing positions or indices).
+  /// changed since. Re-run analyze_mesh_topology after editing positions or indices:
+  /// check_scene refuses a closed mesh whose analysis no longer holds.
   std::size_t analyzed_triangle_count = 0;
 };
 
@@ -260,8 +261,8 @@ struct MeshInstance {
   /// Scene::lit.
   std::vector<Material> materials;
   NormalSource normals = NormalSource::File;
-  /// The corner normals this instance uses (MeshData::corner_normals, or the smoothed ones);
-  /// null for flat normals.
+  /// The corner normals this instance uses (MeshData::corner_normals, or the smoothed ones),
+  /// 3 per triangle; null: each triangle's face normal, whatever `normals` says.
   std::shared_ptr<const std::vector<glm::vec3>> corner_normals;
 };
 
@@ -483,8 +484,11 @@ void add_light(Scene& scene, Light light);
 /// direction), a background in 0..1, an exposure > 0, an environment as load_environment
 /// makes one (a map of width x height finite texels >= 0 within the limits, a finite rotation,
 /// an intensity >= 0), and each instance (a mesh, indices in range, array sizes that match, a
-/// finite affine model matrix, one material per mesh material). Throws
-/// InputError naming the first problem. O(triangles); the renderer does not call it.
+/// finite affine model matrix, one material per mesh material), and for each mesh analysed as
+/// closed that its analysis still holds (analyze_mesh_topology gives the same closed_orientation,
+/// convex and bounds: positions edited afterwards would make the renderer cull wrongly). Throws
+/// InputError naming the first problem. O(triangles), and O(n log n) for each closed mesh; the
+/// renderer calls it only in debug builds and builds with COVRAST_CHECKS.
 void check_scene(const Scene& scene);
 
 /// The per_triangle debug colour: h = lowbias32(index), r = (h & 255) / 255, g = (h >> 8 &

@@ -307,6 +307,12 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options) {
                      " (0 = all cores)");
   }
   int threads = options.threads > 0 ? options.threads : tbb::info::default_concurrency();
+#if !defined(NDEBUG) || defined(COVRAST_CHECKS)
+  // The scene's precondition (renderer.hpp), checked where covrast checks its invariants
+  // (core/checks.hpp: debug, sanitizer and checks builds): a scene that check_scene refuses is
+  // an InputError naming the problem here, not undefined behaviour in a later stage.
+  check_scene(scene);
+#endif
   // Fail early on modes that cannot be built.
   detail::make_tile_rasterizer(options.mode, options.tile);
   if (options.mode.kind == ModeKind::Fxaa) check_fxaa_options(options.fxaa);

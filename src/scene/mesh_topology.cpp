@@ -15,6 +15,8 @@
 //    that sum and all the same sign. One sign per component matters: a closed mesh made of an
 //    outward sphere and a separate inward one passes the edge test, but culling by the sign of
 //    the total volume would drop the visible faces of the inward one.
+#include "scene/scene_internal.hpp"
+
 #include <covrast/scene.hpp>
 
 #include <algorithm>
@@ -219,17 +221,15 @@ bool convex_of(const MeshData& mesh, const std::vector<std::uint8_t>& used, int 
 
 }  // namespace
 
-void analyze_mesh_topology(MeshData& mesh) {
-  mesh.closed_orientation = 0;
-  mesh.convex = false;
-  mesh.bounds_min = glm::vec3(0.0f);
-  mesh.bounds_max = glm::vec3(0.0f);
-  mesh.analyzed_triangle_count = mesh.triangle_count();
+namespace detail {
+
+MeshTopologyFacts mesh_topology_facts(const MeshData& mesh) {
+  MeshTopologyFacts facts;
   const std::size_t vertex_count = mesh.positions.size();
   const std::size_t triangle_count = mesh.triangle_count();
   if (vertex_count >= kMaxWeldedVertices ||
       triangle_count >= std::numeric_limits<std::uint32_t>::max()) {
-    return;  // beyond what the packed edge keys hold: leave the mesh unculled
+    return facts;  // beyond what the packed edge keys hold: leave the mesh unculled
   }
   std::vector<std::uint8_t> used(vertex_count, 0);
   bool all_finite = true;
@@ -238,7 +238,7 @@ void analyze_mesh_topology(MeshData& mesh) {
   glm::vec3 hi(-std::numeric_limits<float>::infinity());
   for (std::size_t i = 0; i < triangle_count * 3; ++i) {
     const std::uint32_t v = mesh.indices[i];
-    if (v >= vertex_count) return;  // a mesh built in code with a bad index: never culled
+    if (v >= vertex_count) return facts;  // a mesh built in code with a bad index: never culled
     if (used[v]) continue;
     used[v] = 1;
     const glm::vec3& p = mesh.positions[v];
@@ -251,15 +251,40 @@ void analyze_mesh_topology(MeshData& mesh) {
     hi = glm::max(hi, p);
   }
   if (any_used) {
-    mesh.bounds_min = lo;
-    mesh.bounds_max = hi;
+    facts.bounds_min = lo;
+    facts.bounds_max = hi;
   }
-  if (!all_finite || !any_used) return;
-  mesh.closed_orientation = closed_orientation_of(mesh, used);
-  if (mesh.closed_orientation != 0 && vertex_count <= kMaxConvexTestVertices) {
+  if (!all_finite || !any_used) return facts;
+  facts.closed_orientation = closed_orientation_of(mesh, used);
+  if (facts.closed_orientation != 0 && vertex_count <= kMaxConvexTestVertices) {
     const double diagonal = glm::length(glm::dvec3(hi) - glm::dvec3(lo));
-    mesh.convex = convex_of(mesh, used, mesh.closed_orientation, diagonal);
+    facts.convex = convex_of(mesh, used, facts.closed_orientation, diagonal);
   }
+  return facts;
 }
+
+}  // namespace detail
+
+void analyze_mesh_topology(MeshData& mesh) {
+  const detail::MeshTopologyFacts facts = detail::mesh_topology_facts(mesh);
+  mesh.closed_orientation = facts.closed_orientation;
+  mesh.convex = facts.convex;
+  mesh.bounds_min = facts.bounds_min;
+  mesh.bounds_max = facts.bounds_max;
+  mesh.analyzed_triangle_count = mesh.triangle_count();
+}
+
+namespace detail {
+
+bool mesh_topology_is_current(const MeshData& mesh) {
+  if (mesh.analyzed_triangle_count != mesh.triangle_count() || mesh.closed_orientation == 0) {
+    return true;  // the renderer culls nothing of it, whatever the mesh holds now
+  }
+  const MeshTopologyFacts facts = mesh_topology_facts(mesh);
+  return facts.closed_orientation == mesh.closed_orientation && facts.convex == mesh.convex &&
+         facts.bounds_min == mesh.bounds_min && facts.bounds_max == mesh.bounds_max;
+}
+
+}  // namespace detail
 
 }  // namespace covrast

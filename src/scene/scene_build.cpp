@@ -1,11 +1,14 @@
 // Building a scene in code: make_mesh, add_instance, add_light and check_scene, the in-memory
 // twins of what the scene file loader (scene_json.cpp) and the OBJ parser do, with the same
 // rules and a one-line InputError for each broken one.
+#include "scene/scene_internal.hpp"
+
 #include <covrast/scene.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <unordered_set>
 #include <utility>
 
 namespace covrast {
@@ -377,12 +380,18 @@ void check_scene(const Scene& scene) {
   if (scene.background_kind == BackgroundKind::Skybox && !scene.environment) {
     fail("background", "a skybox needs an environment");
   }
+  std::unordered_set<const MeshData*> analysis_checked;  // once per mesh, not per instance
   for (std::size_t i = 0; i < scene.meshes.size(); ++i) {
     const MeshInstance& instance = scene.meshes[i];
     const std::string what = "meshes[" + std::to_string(i) + "]";
     if (!instance.mesh) fail(what, "no mesh");
     const MeshData& mesh = *instance.mesh;
     check_mesh_arrays(mesh, what + " (" + mesh.source + ")");
+    if (analysis_checked.insert(&mesh).second && !detail::mesh_topology_is_current(mesh)) {
+      fail(what + " (" + mesh.source + ")",
+           "its positions or indices changed after analyze_mesh_topology (closed_orientation, "
+           "convex or bounds no longer hold): call analyze_mesh_topology again");
+    }
     check_model(instance.model, what);
     // Empty: one Material{} (MeshInstance::materials).
     if (!instance.materials.empty() &&
@@ -393,9 +402,9 @@ void check_scene(const Scene& scene) {
     if (instance.color_source == ColorSource::Vertex && mesh.colors_linear.empty()) {
       fail(what, "vertex colours, but the mesh has none");
     }
-    if (instance.normals != NormalSource::Flat &&
-        (!instance.corner_normals || instance.corner_normals->size() != mesh.indices.size())) {
-      fail(what, "corner normals missing or not 3 per triangle");
+    // No corner normals: each triangle's face normal, whatever `normals` says (MeshInstance).
+    if (instance.corner_normals && instance.corner_normals->size() != mesh.indices.size()) {
+      fail(what, "corner normals not 3 per triangle");
     }
   }
 }

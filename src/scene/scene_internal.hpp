@@ -124,4 +124,18 @@ void check_obj_text(std::string_view text, const std::string& name);
 /// True if the bytes start with the binary glTF magic "glTF".
 bool is_glb(std::string_view bytes);
 
+/// What analyze_mesh_topology stores in a MeshData, computed from its positions and indices.
+struct MeshTopologyFacts {
+  int closed_orientation = 0;
+  bool convex = false;
+  glm::vec3 bounds_min{0.0f};
+  glm::vec3 bounds_max{0.0f};
+};
+MeshTopologyFacts mesh_topology_facts(const MeshData& mesh);
+
+/// Whether what the renderer reads of a mesh's analysis still holds: a mesh analysed as closed
+/// (closed_orientation != 0, analyzed_triangle_count = triangle_count()) gives the same facts
+/// again. O(n log n) for a closed mesh, O(1) otherwise (check_scene calls it).
+bool mesh_topology_is_current(const MeshData& mesh);
+
 }  // namespace covrast::detail
