@@ -13,6 +13,7 @@
 #include "core/tile_raster.hpp"
 #include "raster/aliased/aliased_kernel.hpp"
 #include "raster/rasterizers.hpp"
+#include "shading/composite.hpp"
 #include "shading/shading.hpp"
 
 #include <algorithm>
@@ -184,8 +185,7 @@ class AliasedRasterizer final : public TileRasterizer {
         }
         if (stack.empty()) continue;
         std::sort(stack.begin(), stack.end(), [](const auto& a, const auto& b) {
-          return a.first < b.first ||
-                 (a.first == b.first && a.second->primitive < b.second->primitive);
+          return nearer_first(a.first, *a.second, b.first, *b.second);
         });
         std::uint8_t* dst = target.color->pixel(x, y);
         glm::dvec3 behind(target.background_linear);
@@ -199,15 +199,11 @@ class AliasedRasterizer final : public TileRasterizer {
             behind = glm::dvec3(shade(o, x + 0.5, y + 0.5, false));
           }
         }
-        glm::dvec3 c(0.0);
-        double transmit = 1.0;
+        FrontToBack layers_over;
         for (const auto& layer : stack) {
-          const ShadedColor sc = shade_rgba(*layer.second, x + 0.5, y + 0.5, false);
-          const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
-          c += transmit * alpha * glm::dvec3(sc.rgb);
-          transmit *= 1.0 - alpha;
+          layers_over.add(shade_rgba(*layer.second, x + 0.5, y + 0.5, false));
         }
-        c += transmit * behind;
+        const glm::dvec3 c = layers_over.over(behind);
         for (int k = 0; k < 3; ++k) dst[k] = encode_srgb8(float(c[k]));
       }
     }

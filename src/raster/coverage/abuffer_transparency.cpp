@@ -22,6 +22,7 @@
 #include "core/testing_hooks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 #include "raster/coverage/fragment_shading.hpp"
+#include "shading/composite.hpp"
 
 #include <algorithm>
 #include <limits>
@@ -38,15 +39,6 @@ struct ABufferTile::Clear {
   int owned;         ///< samples in mask
   double shown = 0;  ///< sum over its samples of V T (then the mean S)
 };
-
-namespace {
-
-/// a before b in depth order: nearer, or level and drawn earlier.
-bool nearer(double za, const TriangleSetup& a, double zb, const TriangleSetup& b) {
-  return za < zb || (za == zb && a.primitive < b.primitive);
-}
-
-}  // namespace
 
 void ABufferTile::add_transparent(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
                                   double centre_z) {
@@ -131,14 +123,10 @@ bool ABufferTile::uniform_transparency(std::size_t pixel, int x, int y, double& 
   for (std::size_t k = 1; k < layers.size(); ++k) {
     if (!(layers[k - 1].range.max < layers[k].range.min)) return false;  // they may cross
   }
-  transmit = 1.0;
-  light = glm::dvec3(0.0);
-  for (const Layer1& layer : layers) {
-    const ShadedColor c = shade_fragment_rgba(*layer.t, x, y);
-    const double alpha = std::clamp(c.alpha, 0.0, 1.0);
-    light += transmit * alpha * glm::dvec3(c.rgb);
-    transmit *= 1.0 - alpha;
-  }
+  FrontToBack layers_over;
+  for (const Layer1& layer : layers) layers_over.add(shade_fragment_rgba(*layer.t, x, y));
+  transmit = layers_over.transmit;
+  light = layers_over.light;
   return true;
 }
 
@@ -171,7 +159,7 @@ void ABufferTile::transmittance_by_samples(std::vector<Clear>& clear, int x, int
       if (z < z_opaque[k]) stack.emplace_back(z, j);
     }
     std::sort(stack.begin(), stack.end(), [&](const auto& a, const auto& b) {
-      return nearer(a.first, *clear[a.second].t, b.first, *clear[b.second].t);
+      return nearer_first(a.first, *clear[a.second].t, b.first, *clear[b.second].t);
     });
     double t = 1.0;
     for (const auto& [z, j] : stack) {
@@ -217,7 +205,8 @@ void ABufferTile::sliver_transmittance(std::size_t pixel, int x, int y, std::vec
     double t = 1.0;
     for (int i = 0; i < n && visible; ++i) {
       if (i == j || !covers_point(*clear[i].t, px, py)) continue;
-      if (nearer(clear[i].t->depth_at(px, py), *clear[i].t, zj, *c.t)) t *= 1.0 - clear[i].alpha;
+      if (nearer_first(clear[i].t->depth_at(px, py), *clear[i].t, zj, *c.t))
+        t *= 1.0 - clear[i].alpha;
     }
     c.shown = visible ? t : 0.0;
     c.owned = 1;

@@ -4,6 +4,7 @@
 
 #include "color/srgb8.hpp"
 #include "core/edge_function.hpp"
+#include "shading/composite.hpp"
 #include "shading/shading.hpp"
 
 #include <algorithm>
@@ -176,21 +177,15 @@ glm::dvec3 ReferenceRasterizer::composite_pixel(int x, int y, double& nearest) {
         stack.emplace_back(layer_z_[b * count + s], b);
       }
     }
-    // Nearest first; level ones in draw order (the lower primitive index in front).
     std::sort(stack.begin(), stack.end(), [&](const auto& a, const auto& b) {
-      return a.first < b.first ||
-             (a.first == b.first && pending_[blend_[a.second]].triangle->primitive <
-                                        pending_[blend_[b.second]].triangle->primitive);
+      return nearer_first(a.first, *pending_[blend_[a.second]].triangle, b.first,
+                          *pending_[blend_[b.second]].triangle);
     });
-    glm::dvec3 c(0.0);
-    double transmit = 1.0;
+    FrontToBack layers_over;
     for (const auto& layer : stack) {
-      const ShadedColor sc = shade_rgba(*pending_[blend_[layer.second]].triangle, sx, sy, false);
-      const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
-      c += transmit * alpha * glm::dvec3(sc.rgb);
-      transmit *= 1.0 - alpha;
+      layers_over.add(shade_rgba(*pending_[blend_[layer.second]].triangle, sx, sy, false));
     }
-    sum += c + transmit * behind;
+    sum += layers_over.over(behind);
   }
   return sum / double(count);
 }

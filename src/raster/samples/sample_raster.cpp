@@ -4,6 +4,7 @@
 
 #include "color/srgb8.hpp"
 #include "core/edge_function.hpp"
+#include "shading/composite.hpp"
 #include "shading/shading.hpp"
 
 #include <algorithm>
@@ -358,26 +359,21 @@ void SampleRasterizer::composite_band() {
         }
         if (stack.empty()) continue;
         std::sort(stack.begin(), stack.end(), [](const auto& a, const auto& b) {
-          return a.first < b.first ||
-                 (a.first == b.first && a.second->primitive < b.second->primitive);
+          return nearer_first(a.first, *a.second, b.first, *b.second);
         });
         std::uint32_t* rgb[3] = {&r_[base + std::size_t(l)], &g_[base + std::size_t(l)],
                                  &b_[base + std::size_t(l)]};
         const bool empty = !(depth < std::numeric_limits<float>::infinity());
-        glm::dvec3 c(0.0);
-        double transmit = 1.0;
+        FrontToBack layers_over;
         for (const auto& layer : stack) {
-          const ShadedColor sc = rate_ == ShadingRate::PerPixel
-                                     ? shade_rgba(*layer.second, x + 0.5, y + 0.5, true)
-                                     : shade_rgba(*layer.second, sx * inv, sy * inv, false);
-          const double alpha = std::clamp(sc.alpha, 0.0, 1.0);
-          c += transmit * alpha * glm::dvec3(sc.rgb);
-          transmit *= 1.0 - alpha;
+          layers_over.add(rate_ == ShadingRate::PerPixel
+                              ? shade_rgba(*layer.second, x + 0.5, y + 0.5, true)
+                              : shade_rgba(*layer.second, sx * inv, sy * inv, false));
         }
-        for (int k = 0; k < 3; ++k) {
-          const double behind = (empty ? background_q_[k] : *rgb[k]) / kColorOne;
-          *rgb[k] = quantize_color(float(c[k] + transmit * behind));
-        }
+        glm::dvec3 behind;
+        for (int k = 0; k < 3; ++k) behind[k] = (empty ? background_q_[k] : *rgb[k]) / kColorOne;
+        const glm::dvec3 c = layers_over.over(behind);
+        for (int k = 0; k < 3; ++k) *rgb[k] = quantize_color(float(c[k]));
         if (empty) depth = std::numeric_limits<float>::max();
       }
     }
