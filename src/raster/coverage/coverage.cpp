@@ -77,6 +77,9 @@ class CoverageRasterizer final : public TileRasterizer {
       // Only a triangle at least a block wide and high can cover a whole block.
       if (r.x1 - r.x0 >= 8 && r.y1 - r.y0 >= 8) skip_decided = abuffer_.add_covering_blocks(t, r);
     }
+    // Per (triangle, tile) and after the skips above, not once at set-up: a triangle meets
+    // 1.03-1.22 tiles on the report's dense scenes, while the hidden skip alone spares it for
+    // 45% of ReciprocatingSaw's bin entries (640x360, --stats).
     const CoverageTriangle tri = make_coverage_triangle(t);
     // With decided blocks, column groups line up with the blocks, so that a row of a group
     // lies in one block (columns left of the triangle get zero coverage).
