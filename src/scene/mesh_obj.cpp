@@ -130,10 +130,7 @@ class ObjParser {
 
   /// One line, without its line end; `line_no` counts from 1.
   void read_line(std::string_view line, std::size_t line_no) {
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
-    }
-    Tokens tokens(line);
+    Tokens tokens(without_comment(line));
     std::string_view keyword;
     if (!tokens.next(keyword)) return;
     if (keyword == "v") {

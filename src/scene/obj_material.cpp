@@ -26,10 +26,7 @@ class MtlParser {
       : name_(name), directory_(directory), library_(library) {}
 
   void read_line(std::string_view line, std::size_t line_no) {
-    if (const std::size_t hash = line.find('#'); hash != std::string_view::npos) {
-      line = line.substr(0, hash);
-    }
-    Tokens tokens(line);
+    Tokens tokens(without_comment(line));
     std::string_view keyword;
     if (!tokens.next(keyword)) return;
     line_no_ = line_no;

@@ -1,6 +1,6 @@
 // Line-level text helpers shared by the Wavefront OBJ reader (mesh_obj.cpp) and its material
-// library reader (mesh_mtl.cpp): whitespace tokens, numbers as exporters write them, and
-// tokens shortened for one-line messages.
+// library reader (obj_material.cpp): comments, whitespace tokens, numbers as exporters write
+// them, and tokens shortened for one-line messages.
 #pragma once
 
 #include <covrast/error.hpp>
@@ -15,6 +15,13 @@ namespace covrast::detail {
 
 inline bool is_blank(char c) {
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
+}
+
+/// The line without its comment: in OBJ and MTL files a '#' starts one that runs to the end of
+/// the line.
+inline std::string_view without_comment(std::string_view line) {
+  const std::size_t hash = line.find('#');
+  return hash == std::string_view::npos ? line : line.substr(0, hash);
 }
 
 /// Splits one line into whitespace-separated tokens.
