@@ -263,12 +263,11 @@ using covrast::test::pixel_scene;
 using covrast::test::render_mode;
 
 void add_mesh(Scene& scene, std::vector<glm::vec3> positions, std::vector<std::uint32_t> indices,
-              ColorSource source, std::vector<glm::vec3> colours = {}) {
+              ColorSource source) {
   auto mesh = std::make_shared<MeshData>();
   mesh->source = "test_fxaa";
   mesh->positions = std::move(positions);
   mesh->indices = std::move(indices);
-  mesh->colors_linear = std::move(colours);
   MeshInstance instance;
   instance.mesh = std::move(mesh);
   instance.color_source = source;
@@ -289,7 +288,7 @@ Scene random_triangles_scene() {
     for (int k = 0; k < 3; ++k) positions.emplace_back(x(rng), y(rng), depth);
     for (std::uint32_t k = 0; k < 3; ++k) indices.push_back(3 * t + k);
   }
-  add_mesh(scene, std::move(positions), std::move(indices), ColorSource::PerTriangle, {});
+  add_mesh(scene, std::move(positions), std::move(indices), ColorSource::PerTriangle);
   return scene;
 }
 

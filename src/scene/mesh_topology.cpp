@@ -263,19 +263,6 @@ MeshTopologyFacts mesh_topology_facts(const MeshData& mesh) {
   return facts;
 }
 
-}  // namespace detail
-
-void analyze_mesh_topology(MeshData& mesh) {
-  const detail::MeshTopologyFacts facts = detail::mesh_topology_facts(mesh);
-  mesh.closed_orientation = facts.closed_orientation;
-  mesh.convex = facts.convex;
-  mesh.bounds_min = facts.bounds_min;
-  mesh.bounds_max = facts.bounds_max;
-  mesh.analyzed_triangle_count = mesh.triangle_count();
-}
-
-namespace detail {
-
 bool mesh_topology_is_current(const MeshData& mesh) {
   if (mesh.analyzed_triangle_count != mesh.triangle_count() || mesh.closed_orientation == 0) {
     return true;  // the renderer culls nothing of it, whatever the mesh holds now
@@ -286,5 +273,14 @@ bool mesh_topology_is_current(const MeshData& mesh) {
 }
 
 }  // namespace detail
+
+void analyze_mesh_topology(MeshData& mesh) {
+  const detail::MeshTopologyFacts facts = detail::mesh_topology_facts(mesh);
+  mesh.closed_orientation = facts.closed_orientation;
+  mesh.convex = facts.convex;
+  mesh.bounds_min = facts.bounds_min;
+  mesh.bounds_max = facts.bounds_max;
+  mesh.analyzed_triangle_count = mesh.triangle_count();
+}
 
 }  // namespace covrast

@@ -219,7 +219,7 @@ bool ABufferTile::hides_pixel(const TriangleSetup& t, int x, int y) const {
   const int logged = log_.count(pixel);
   if (logged == 0) {
     // A partial fragment over a started list would turn the log off.
-    return head_[pixel] == kEnd && layer_[pixel] == Layer::Empty && behind_opaque;
+    return !list_started(pixel) && behind_opaque;
   }
   if (near >= log_.hidden_from(pixel)) return true;
   return logged < kMaxLoggedFragments && behind_opaque;  // at the limit: handed to the list

@@ -214,6 +214,11 @@ class ABufferTile {
 
   inline DepthOrder order_against_opaque(const TriangleSetup& t, double t_centre_z,
                                          std::size_t pixel, int x, int y) const;
+  /// Whether the pixel's fragment list has begun (a fragment, or a layer state), which turns
+  /// an empty log off when a partial fragment arrives (log_fragment, hides_pixel).
+  bool list_started(std::size_t pixel) const {
+    return head_[pixel] != kEnd || layer_[pixel] != Layer::Empty;
+  }
   /// Whether add() would drop the fragment of `t` at pixel (x, y) as hidden (hides_rect).
   bool hides_pixel(const TriangleSetup& t, int x, int y) const;
   /// add() for a pixel whose log is not Off: logs the fragment, drops it (hidden), or returns

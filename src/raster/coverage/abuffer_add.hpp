@@ -36,8 +36,8 @@ inline bool ABufferTile::log_fragment(std::size_t pixel, int x, int y, const Tri
   if (log_.count(pixel) == 0) {
     // Nothing logged: a full fragment is the ordinary depth test against the opaque one.
     if (coverage == std::uint32_t(kCoverageOne)) return false;
-    if (head_[pixel] != kEnd || layer_[pixel] != Layer::Empty) {
-      // That test kept a full fragment that crosses the opaque one: the list has begun.
+    if (list_started(pixel)) {
+      // That test kept a full fragment that crosses the opaque one.
       log_.turn_off(pixel);
       return false;
     }
