@@ -28,6 +28,7 @@ cp "$tmp/default-coverage.png" "$out/default-coverage.png"
 "$build/covrast" render docs/scenes/sheen.json -o "$out/sheen.png" --quiet
 "$build/covrast" render docs/scenes/iridescence.json -o "$out/iridescence.png" --quiet
 "$build/covrast" render docs/scenes/anisotropy.json -o "$out/anisotropy.png" --quiet
+"$build/covrast" render docs/scenes/transmission.json -o "$out/transmission.png" --quiet
 # covrast test's HTML report (docs/ci.md): two cases, one of whose goldens is wrong (an
 # aliased render), as Chromium shows the page. Paths relative to the manifest's folder.
 mkdir -p "$tmp/ci/goldens"

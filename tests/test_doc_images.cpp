@@ -72,4 +72,6 @@ TEST_CASE("docs: the pictures show what this build renders", "[docs]") {
         render_scene("docs/scenes/iridescence.json", "coverage").rgb);
   CHECK(covrast::read_png(images / "anisotropy.png").rgb ==
         render_scene("docs/scenes/anisotropy.json", "coverage").rgb);
+  CHECK(covrast::read_png(images / "transmission.png").rgb ==
+        render_scene("docs/scenes/transmission.json", "coverage").rgb);
 }

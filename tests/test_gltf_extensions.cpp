@@ -39,7 +39,7 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
   using covrast::GltfExtensionSupport;
   CHECK(covrast::gltf_extension_support("KHR_texture_transform").support ==
         GltfExtensionSupport::Honoured);
-  CHECK(covrast::gltf_extension_support("KHR_materials_volume").support ==
+  CHECK(covrast::gltf_extension_support("KHR_materials_diffuse_transmission").support ==
         GltfExtensionSupport::Ignored);
   CHECK(covrast::gltf_extension_support("EXT_meshopt_compression").support ==
         GltfExtensionSupport::Honoured);
@@ -49,14 +49,16 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
 
   covrast::test::TempDir dir("covrast-ext");
   const std::filesystem::path file = dir / "t.glb";
-  std::ofstream(file, std::ios::binary)
-      << triangle_using({"KHR_texture_transform", "KHR_materials_volume", "EXT_made_up"});
+  std::ofstream(file, std::ios::binary) << triangle_using(
+      {"KHR_texture_transform", "KHR_materials_diffuse_transmission", "EXT_made_up"});
   // A model file renders lit: the material extension warns, so does the unknown one; the
   // honoured one does not.
   const covrast::Scene lit = covrast::load_mesh_scene(file, 32, 32);
-  CHECK(lit.gltf_extensions_used ==
-        std::vector<std::string>{"EXT_made_up", "KHR_materials_volume", "KHR_texture_transform"});
-  CHECK(count_containing(lit.warnings, "KHR_materials_volume, which covrast ignores") == 1);
+  CHECK(lit.gltf_extensions_used == std::vector<std::string>{"EXT_made_up",
+                                                             "KHR_materials_diffuse_transmission",
+                                                             "KHR_texture_transform"});
+  CHECK(count_containing(lit.warnings,
+                         "KHR_materials_diffuse_transmission, which covrast ignores") == 1);
   CHECK(count_containing(lit.warnings, "EXT_made_up, which covrast ignores") == 1);
   CHECK(count_containing(lit.warnings, "KHR_texture_transform") == 0);
   // An unlit scene: the material extension changes nothing there, so it does not warn.
@@ -65,7 +67,7 @@ TEST_CASE("gltf extensions: each is honoured, ignored with a warning or cannot b
             "up": [0, 1, 0], "fovy_deg": 40, "near": 0.1, "far": 10},
             "meshes": [{"gltf": "t.glb"}, {"gltf": "t.glb"}]})";
   const covrast::Scene unlit = covrast::load_scene(dir / "s.json");
-  CHECK(count_containing(unlit.warnings, "KHR_materials_volume") == 0);
+  CHECK(count_containing(unlit.warnings, "KHR_materials_diffuse_transmission") == 0);
   CHECK(count_containing(unlit.warnings, "EXT_made_up") == 1);  // once for the file
   CHECK(unlit.gltf_extensions_used.size() == 3);
   // Required and not readable: refused, naming it.

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "test_extension_sphere.hpp"
 #include "test_gltf_files.hpp"
 #include "test_sphere_scene.hpp"
 #include "test_tempdir.hpp"
@@ -33,23 +34,13 @@ using covrast::Light;
 using covrast::LightType;
 using covrast::Material;
 using covrast::ShadingModel;
+using covrast::test::ggx_d;
+using covrast::test::smith_v;
+using covrast::test::worst_difference;
 
 namespace {
 
 constexpr double kPi = std::numbers::pi;
-
-/// GGX D and the height-correlated Smith V of glTF Appendix B.3.5, written out.
-double ggx_d(double alpha, double n_h) {
-  if (!(n_h > 0.0)) return 0.0;
-  const double a2 = alpha * alpha;
-  return a2 / (kPi * std::pow(n_h * n_h * (a2 - 1.0) + 1.0, 2.0));
-}
-double smith_v(double alpha, double n_l, double n_v, double h_l, double h_v) {
-  if (!(h_l > 0.0 && h_v > 0.0)) return 0.0;
-  const double a2 = alpha * alpha;
-  const auto g = [&](double x) { return std::abs(x) + std::sqrt(a2 + (1.0 - a2) * x * x); };
-  return 1.0 / (g(n_l) * g(n_v));
-}
 
 /// KHR_materials_sheen's lobe D V, written out from the extension's implementation notes
 /// ("Charlie" distribution and visibility, Conty Estevez and Kulla 2017).
@@ -280,65 +271,8 @@ void sphere_tangents(covrast::Scene& scene) {
 covrast::Scene extension_sphere(const glm::dvec3& base, const Material& m) {
   covrast::Scene scene = covrast::test::lit_sphere_scene(glm::vec3(base), m);
   sphere_tangents(scene);
-  Light sun;
-  sun.type = LightType::Directional;
-  sun.direction = kSunDirection;
-  sun.intensity = kSun;
-  Light sky;
-  sky.type = LightType::Ambient;
-  sky.intensity = kSky;
-  scene.lights = {sun, sky};
+  covrast::test::light_sun_and_sky(scene, kSunDirection, kSun, kSky);
   return scene;
-}
-
-/// The 8-bit codes of `expected(n, v)` at image point (x, y) of the sphere seen from (0, 0, 3)
-/// (as test_sphere_scene.hpp's worst_sphere_difference), or false off the interior.
-bool formula_codes(const covrast::Scene& scene, double x, double y,
-                   const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected,
-                   int codes[3]) {
-  const double t = std::tan(scene.camera.fovy_deg * kPi / 360.0);
-  const glm::dvec3 d = glm::normalize(
-      glm::dvec3((2.0 * x / scene.width - 1.0) * t, (1.0 - 2.0 * y / scene.height) * t, -1.0));
-  const glm::dvec3 o = scene.camera.eye;
-  const double b = glm::dot(o, d), disc = b * b - (glm::dot(o, o) - 1.0);
-  if (disc <= 0.0) return false;
-  const glm::dvec3 n = o + (-b - std::sqrt(disc)) * d;
-  if (glm::dot(n, -d) < 0.3) return false;
-  const glm::dvec3 value = expected(n, -d);
-  for (int c = 0; c < 3; ++c) codes[c] = covrast::detail::encode_srgb8(float(value[c]));
-  return true;
-}
-
-/// The largest difference between `image` and the formula at the pixel centres of the interior.
-/// With `smooth_only`, only over the pixels where the formula changes by at most one code
-/// within 0.75 pixel of the centre: coverage and msaa shade each triangle of a pixel at the
-/// centre clamped into it, up to 0.7 pixel away, so where the formula is steeper (a sharp
-/// highlight) they differ from the centre's value by what the formula changes over that
-/// distance, not by an error of the material.
-int worst_difference(
-    const covrast::Image& image, const covrast::Scene& scene,
-    const std::function<glm::dvec3(const glm::dvec3&, const glm::dvec3&)>& expected,
-    bool smooth_only, int& checked) {
-  int worst = 0;
-  checked = 0;
-  for (int y = 0; y < scene.height; ++y) {
-    for (int x = 0; x < scene.width; ++x) {
-      int centre[3];
-      if (!formula_codes(scene, x + 0.5, y + 0.5, expected, centre)) continue;
-      bool smooth = true;
-      for (int k = 0; smooth_only && smooth && k < 4; ++k) {
-        int near[3];
-        smooth = formula_codes(scene, x + 0.5 + (k & 1 ? 0.75 : -0.75),
-                               y + 0.5 + (k & 2 ? 0.75 : -0.75), expected, near);
-        for (int c = 0; smooth && c < 3; ++c) smooth = std::abs(near[c] - centre[c]) <= 1;
-      }
-      if (!smooth) continue;
-      const std::uint8_t* p = image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(int(p[c]) - centre[c]));
-      ++checked;
-    }
-  }
-  return worst;
 }
 
 }  // namespace
@@ -581,50 +515,67 @@ TEST_CASE("glTF material extensions at their neutral values draw today's bytes",
       {"KHR_materials_clearcoat", {{"clearcoatFactor", 0.0}, {"clearcoatRoughnessFactor", 0.4}}},
       {"KHR_materials_sheen", {{"sheenColorFactor", {0, 0, 0}}, {"sheenRoughnessFactor", 0.5}}},
       {"KHR_materials_iridescence", {{"iridescenceFactor", 0.0}, {"iridescenceIor", 1.6}}},
-      {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.0}, {"anisotropyRotation", 0.7}}}};
+      {"KHR_materials_anisotropy", {{"anisotropyStrength", 0.0}, {"anisotropyRotation", 0.7}}},
+      {"KHR_materials_transmission", {{"transmissionFactor", 0.0}}},
+      {"KHR_materials_volume",
+       {{"thicknessFactor", 0.5}, {"attenuationDistance", 0.2}, {"attenuationColor", {1, 0, 0}}}},
+      {"KHR_materials_dispersion", {{"dispersion", 0.3}}}};
   std::ofstream(dir / "neutral.glb", std::ios::binary) << sphere_gltf(neutral);
   nlohmann::json coated = neutral;
   coated["KHR_materials_clearcoat"]["clearcoatFactor"] = 1.0;
   std::ofstream(dir / "coated.glb", std::ios::binary) << sphere_gltf(coated);
+  nlohmann::json clear = neutral;
+  clear["KHR_materials_transmission"]["transmissionFactor"] = 1.0;
+  std::ofstream(dir / "clear.glb", std::ios::binary) << sphere_gltf(clear);
   for (const char* mode : {"coverage", "aliased", "msaa:4"}) {
     INFO(mode);
     const covrast::Image plain = render_lit(dir / "plain.glb", mode);
     CHECK((render_lit(dir / "neutral.glb", mode).rgb == plain.rgb));
     CHECK((render_lit(dir / "coated.glb", mode).rgb != plain.rgb));
+    CHECK((render_lit(dir / "clear.glb", mode).rgb != plain.rgb));
   }
 }
 
 TEST_CASE("glTF material extensions: fields and textures read and wrong values named by path",
           "[gltf][extensions]") {
   covrast::test::TempDir dir("covrast-material-extensions");
-  const nlohmann::json all = {{"KHR_materials_ior", {{"ior", 1.33}}},
-                              {"KHR_materials_specular",
-                               {{"specularFactor", 0.25},
-                                {"specularColorFactor", {2.0, 1.0, 0.5}},
-                                {"specularTexture", {{"index", 0}}},
-                                {"specularColorTexture", {{"index", 0}, {"texCoord", 0}}}}},
-                              {"KHR_materials_clearcoat",
-                               {{"clearcoatFactor", 0.75},
-                                {"clearcoatRoughnessFactor", 0.125},
-                                {"clearcoatTexture", {{"index", 0}}},
-                                {"clearcoatRoughnessTexture", {{"index", 0}}},
-                                {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.5}}}}},
-                              {"KHR_materials_sheen",
-                               {{"sheenColorFactor", {0.5, 0.25, 1.0}},
-                                {"sheenRoughnessFactor", 0.75},
-                                {"sheenColorTexture", {{"index", 0}}},
-                                {"sheenRoughnessTexture", {{"index", 0}}}}},
-                              {"KHR_materials_iridescence",
-                               {{"iridescenceFactor", 0.5},
-                                {"iridescenceIor", 1.75},
-                                {"iridescenceThicknessMinimum", 150.0},
-                                {"iridescenceThicknessMaximum", 650.0},
-                                {"iridescenceTexture", {{"index", 0}}},
-                                {"iridescenceThicknessTexture", {{"index", 0}}}}},
-                              {"KHR_materials_anisotropy",
-                               {{"anisotropyStrength", 0.625},
-                                {"anisotropyRotation", -2.5},
-                                {"anisotropyTexture", {{"index", 0}}}}}};
+  const nlohmann::json all = {
+      {"KHR_materials_ior", {{"ior", 1.33}}},
+      {"KHR_materials_specular",
+       {{"specularFactor", 0.25},
+        {"specularColorFactor", {2.0, 1.0, 0.5}},
+        {"specularTexture", {{"index", 0}}},
+        {"specularColorTexture", {{"index", 0}, {"texCoord", 0}}}}},
+      {"KHR_materials_clearcoat",
+       {{"clearcoatFactor", 0.75},
+        {"clearcoatRoughnessFactor", 0.125},
+        {"clearcoatTexture", {{"index", 0}}},
+        {"clearcoatRoughnessTexture", {{"index", 0}}},
+        {"clearcoatNormalTexture", {{"index", 0}, {"scale", 0.5}}}}},
+      {"KHR_materials_sheen",
+       {{"sheenColorFactor", {0.5, 0.25, 1.0}},
+        {"sheenRoughnessFactor", 0.75},
+        {"sheenColorTexture", {{"index", 0}}},
+        {"sheenRoughnessTexture", {{"index", 0}}}}},
+      {"KHR_materials_iridescence",
+       {{"iridescenceFactor", 0.5},
+        {"iridescenceIor", 1.75},
+        {"iridescenceThicknessMinimum", 150.0},
+        {"iridescenceThicknessMaximum", 650.0},
+        {"iridescenceTexture", {{"index", 0}}},
+        {"iridescenceThicknessTexture", {{"index", 0}}}}},
+      {"KHR_materials_anisotropy",
+       {{"anisotropyStrength", 0.625},
+        {"anisotropyRotation", -2.5},
+        {"anisotropyTexture", {{"index", 0}}}}},
+      {"KHR_materials_transmission",
+       {{"transmissionFactor", 0.375}, {"transmissionTexture", {{"index", 0}}}}},
+      {"KHR_materials_volume",
+       {{"thicknessFactor", 2.5},
+        {"thicknessTexture", {{"index", 0}}},
+        {"attenuationDistance", 0.75},
+        {"attenuationColor", {0.5, 0.25, 1.0}}}},
+      {"KHR_materials_dispersion", {{"dispersion", 0.125}}}};
   std::ofstream(dir / "all.glb", std::ios::binary) << sphere_gltf(all);
   const covrast::Scene scene = covrast::load_mesh_scene(dir / "all.glb", 32, 32);
   for (const std::string& warning : scene.warnings)
@@ -658,6 +609,14 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
   CHECK(m.anisotropy_rotation == -2.5f);
   REQUIRE(m.anisotropy_texture.texture);
   CHECK_FALSE(m.anisotropy_texture.texture->srgb);
+  CHECK(m.transmission == 0.375f);
+  REQUIRE(m.transmission_texture.texture);
+  CHECK_FALSE(m.transmission_texture.texture->srgb);
+  CHECK(m.thickness == 2.5f);
+  REQUIRE(m.thickness_texture.texture);
+  CHECK(m.attenuation_distance == 0.75f);
+  CHECK(m.attenuation_color == glm::vec3(0.5f, 0.25f, 1.0f));
+  CHECK(m.dispersion == 0.125f);
   // The textured coat draws: the coat texture's R (200/255) scales clearcoatFactor, so it
   // differs from the same file without the coat texture.
   nlohmann::json untextured = all;
@@ -703,6 +662,18 @@ TEST_CASE("glTF material extensions: fields and textures read and wrong values n
        path + "KHR_materials_anisotropy.anisotropyRotation: expected a number in"},
       {{{"KHR_materials_anisotropy", {{"anisotropyTexture", -1}}}},
        path + "KHR_materials_anisotropy.anisotropyTexture: expected a textureInfo object"},
+      {{{"KHR_materials_transmission", {{"transmissionFactor", 1.5}}}},
+       path + "KHR_materials_transmission.transmissionFactor: expected a number in 0..1"},
+      {{{"KHR_materials_transmission", {{"transmissionTexture", -1}}}},
+       path + "KHR_materials_transmission.transmissionTexture: expected a textureInfo object"},
+      {{{"KHR_materials_volume", {{"thicknessFactor", -1}}}},
+       path + "KHR_materials_volume.thicknessFactor: expected a number in 0.."},
+      {{{"KHR_materials_volume", {{"attenuationDistance", 0}}}},
+       path + "KHR_materials_volume.attenuationDistance: expected a number > 0"},
+      {{{"KHR_materials_volume", {{"attenuationColor", {1, 1}}}}},
+       path + "KHR_materials_volume.attenuationColor: expected an array of 3 numbers in 0..1"},
+      {{{"KHR_materials_dispersion", {{"dispersion", "lots"}}}},
+       path + "KHR_materials_dispersion.dispersion: expected a number in 0.."},
       {{{"KHR_materials_ior", {{"ior", 0.5}}}},
        path + "KHR_materials_ior.ior: expected 0 or a number >= 1"},
       {{{"KHR_materials_ior", {{"ior", "1.5"}}}},
@@ -733,7 +704,8 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
                   "clearcoat": 1, "clearcoat_roughness": 0.25, "sheen_color": [1, 0.5, 0],
                   "sheen_roughness": 0.5, "iridescence": 0.25, "iridescence_ior": 1.5,
                   "iridescence_thickness_nm": 500, "anisotropy": 0.75,
-                  "anisotropy_rotation_deg": -90}}]})";
+                  "anisotropy_rotation_deg": -90, "transmission": 0.5, "thickness": 0.25,
+                  "attenuation_color": [1, 0.5, 0], "attenuation_distance": 2}}]})";
   const covrast::Scene scene = covrast::load_scene(dir / "s.json");
   const Material& m = scene.meshes.at(0).materials.at(0);
   CHECK(m.ior == 0.0f);
@@ -748,6 +720,10 @@ TEST_CASE("a scene's material keys set the extensions' fields on any mesh", "[sc
   CHECK(m.iridescence_thickness_max_nm == 500.0f);
   CHECK(m.anisotropy == 0.75f);
   CHECK(m.anisotropy_rotation == float(-kPi / 2.0));
+  CHECK(m.transmission == 0.5f);
+  CHECK(m.thickness == 0.25f);
+  CHECK(m.attenuation_color.g == Approx(0.214).epsilon(0.01));  // sRGB
+  CHECK(m.attenuation_distance == 2.0f);
   // The OBJ has neither tangents nor UVs: no tangent frame, said once.
   REQUIRE(scene.warnings.size() == 1);
   CHECK_THAT(scene.warnings[0], Contains("meshes[0]: anisotropy needs a tangent frame"));

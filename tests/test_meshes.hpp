@@ -4,8 +4,10 @@
 #include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -20,6 +22,15 @@ inline Image render_mode(const Scene& scene, const std::string& mode, int thread
   options.threads = threads;
   options.tile = tile;
   return render(scene, options).color;
+}
+
+/// The largest difference of one channel code between two images of the same size.
+inline int max_difference(const Image& a, const Image& b) {
+  int worst = 0;
+  for (std::size_t i = 0; i < a.rgb.size(); ++i) {
+    worst = std::max(worst, std::abs(int(a.rgb[i]) - int(b.rgb[i])));
+  }
+  return worst;
 }
 
 /// The camera that maps the world plane z = 0 one unit to one pixel: x_px = x + w/2,

@@ -25,6 +25,7 @@
 #include "test_splits.hpp"
 #include "test_tempdir.hpp"
 
+using covrast::test::max_difference;
 using covrast::test::render_mode;
 
 namespace {
@@ -70,13 +71,6 @@ covrast::Material material(covrast::AlphaMode mode, double base_alpha, double cu
   m.base_alpha = base_alpha;
   m.alpha_cutoff = cutoff;
   return m;
-}
-
-int max_difference(const covrast::Image& a, const covrast::Image& b) {
-  int worst = 0;
-  for (std::size_t i = 0; i < a.rgb.size(); ++i)
-    worst = std::max(worst, std::abs(a.rgb[i] - b.rgb[i]));
-  return worst;
 }
 
 int code(double linear) {

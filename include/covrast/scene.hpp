@@ -126,6 +126,22 @@ struct Material {
   float anisotropy = 0.0f;
   float anisotropy_rotation = 0.0f;
   TextureSlot anisotropy_texture;
+  /// KHR_materials_transmission (thin-walled, without refraction): the share (0..1; x the
+  /// texture's R) of the dielectric's diffuse that is light passing through instead: what is
+  /// behind shows through, tinted by the base colour, less the specular's reflectance; lights
+  /// behind shine through a GGX lobe (docs/shading.md, "Transmission"). Such a material is
+  /// composited as a transparent layer in every mode (docs/transparency.md).
+  float transmission = 0.0f;
+  TextureSlot transmission_texture;
+  /// KHR_materials_volume: what passes is attenuated over the thickness (object units, x the
+  /// texture's G, x the instance's scale) as attenuation_color^(thickness / distance);
+  /// distance 0 means infinite (no attenuation).
+  float thickness = 0.0f;
+  TextureSlot thickness_texture;
+  glm::vec3 attenuation_color{1.0f};  ///< linear, 0..1
+  float attenuation_distance = 0.0f;  ///< world units, > 0; 0: infinite
+  /// KHR_materials_dispersion: read and kept; without refraction there is no spread to draw.
+  float dispersion = 0.0f;
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff (glTF default 0.5)
   /// The base colour's alpha (glTF baseColorFactor[3], OBJ d), 0..1; multiplies the vertex
@@ -136,7 +152,7 @@ struct Material {
   std::string base_color_texture_path;
 
   /// Every texture slot, in one order (for checks and listings that treat them alike).
-  std::array<const TextureSlot*, 15> texture_slots() const {
+  std::array<const TextureSlot*, 17> texture_slots() const {
     return {&base_color_texture,
             &metallic_roughness_texture,
             &normal_texture,
@@ -151,7 +167,9 @@ struct Material {
             &sheen_roughness_texture,
             &iridescence_texture,
             &iridescence_thickness_texture,
-            &anisotropy_texture};
+            &anisotropy_texture,
+            &transmission_texture,
+            &thickness_texture};
   }
 };
 

@@ -61,11 +61,13 @@ SurfaceTextures surface_slots(const Material& m, bool lit) {
   out.iridescence = slot(m.iridescence_texture);
   out.iridescence_thickness = slot(m.iridescence_thickness_texture);
   out.anisotropy = slot(m.anisotropy_texture);
+  out.transmission = slot(m.transmission_texture);
+  out.thickness = slot(m.thickness_texture);
   return out;
 }
 
 /// Every slot of `t`, null where the material has none.
-std::array<const TextureSlot*, 15> all_slots(const SurfaceTextures& t) {
+std::array<const TextureSlot*, 17> all_slots(const SurfaceTextures& t) {
   return {t.base_color,
           t.metallic_roughness,
           t.normal,
@@ -80,7 +82,9 @@ std::array<const TextureSlot*, 15> all_slots(const SurfaceTextures& t) {
           t.sheen_roughness,
           t.iridescence,
           t.iridescence_thickness,
-          t.anisotropy};
+          t.anisotropy,
+          t.transmission,
+          t.thickness};
 }
 
 bool any_texture(const SurfaceTextures& t) {
@@ -133,6 +137,11 @@ SurfaceShading surface_shading(const Material& m, const ShadingContext* context)
   s.anisotropy = m.anisotropy;
   s.anisotropy_rotation =
       glm::dvec2(std::cos(double(m.anisotropy_rotation)), std::sin(double(m.anisotropy_rotation)));
+  s.transmission = m.transmission;
+  s.ior = m.ior;
+  s.thickness = m.thickness;
+  s.attenuation_color = glm::dvec3(m.attenuation_color);
+  s.attenuation_distance = m.attenuation_distance;
   return s;
 }
 
@@ -173,6 +182,10 @@ void GeometryFrontEnd::prepare_lighting() {
     for (std::size_t k = 0; k < materials.size(); ++k) {
       SurfaceShading surface = surface_shading(materials[k], &context_);
       if (!scene_.lit) surface.model = ShadingModel::Unlit;  // textured in a scene without lights
+      // KHR_materials_volume's thickness is in the mesh's units: scaled by the instance's
+      // (uniform) scale, |det(model)|^(1/3).
+      surface.thickness *=
+          std::cbrt(std::abs(glm::determinant(glm::dmat3(scene_.meshes[i].model))));
       // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
       // whether or not it has textures.
       surface.has_texture_slots = any_texture(textures_[i][k]);
@@ -181,7 +194,7 @@ void GeometryFrontEnd::prepare_lighting() {
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;
       }
-      if (materials[k].alpha_mode != AlphaMode::Opaque) alpha_[i] = true;
+      if (materials[k].alpha_mode != AlphaMode::Opaque || surface.transmissive()) alpha_[i] = true;
     }
     if (surfaces_[i].empty()) surfaces_[i].push_back(surface_shading(Material{}, &context_));
     if (lit_[i]) vertices_[i].position_world.resize(scene_.meshes[i].mesh->positions.size());
@@ -301,7 +314,8 @@ void GeometryFrontEnd::set_up_shading(const ShadeVertex* shade, const SurfaceSha
     }
     record.textured = &corners;
   }
-  t.alpha_mode = lit.alpha_mode;
+  // A transmissive surface is a transparent layer: what is behind it must stay to show through.
+  t.alpha_mode = lit.transmissive() ? AlphaMode::Blend : lit.alpha_mode;
   t.shading = &record;
   t.flat_color = false;
 }

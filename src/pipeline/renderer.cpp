@@ -352,7 +352,8 @@ RenderResult Renderer::render_frame() {
       detail::key_transparent(result.color, over_white);
     } else if (im.scene.background_kind == BackgroundKind::Skybox) {
       detail::key_skybox(result.color, over_white,
-                         detail::SkyView(im.scene, im.width_px, im.height_px));
+                         detail::SkyView(im.scene, im.width_px, im.height_px),
+                         detail::has_transmission(im.scene));
     }
     t4 = Clock::now();
   });

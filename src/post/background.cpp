@@ -72,17 +72,31 @@ void key_transparent(Image& frame, const Image& over_white) {
   }
 }
 
-void key_skybox(Image& frame, const Image& over_white, const SkyView& sky) {
+bool has_transmission(const Scene& scene) {
+  if (!scene.lit) return false;
+  for (const MeshInstance& instance : scene.meshes) {
+    for (const Material& m : instance.materials) {
+      if (m.model == ShadingModel::Pbr && m.transmission > 0.0f) return true;
+    }
+  }
+  return false;
+}
+
+void key_skybox(Image& frame, const Image& over_white, const SkyView& sky, bool per_channel) {
   const std::array<double, 256>& dec = srgb8_decode_table();
   frame.alpha.clear();
   for (int y = 0; y < frame.height; ++y) {
     for (int x = 0; x < frame.width; ++x) {
       const std::size_t i = std::size_t(y) * std::size_t(frame.width) + std::size_t(x);
       std::uint8_t* rgb = &frame.rgb[3 * i];  // over black in, composited out
-      const double w = background_share(rgb, &over_white.rgb[3 * i]);
+      const std::uint8_t* white = &over_white.rgb[3 * i];
+      const double w = background_share(rgb, white);
       if (w == 0.0) continue;
       const glm::dvec3 k = sky.at(x, y);
-      for (int c = 0; c < 3; ++c) rgb[c] = encode_srgb8(float(dec[rgb[c]] + w * k[c]));
+      for (int c = 0; c < 3; ++c) {
+        const double w_c = per_channel ? std::clamp(dec[white[c]] - dec[rgb[c]], 0.0, 1.0) : w;
+        rgb[c] = encode_srgb8(float(dec[rgb[c]] + w_c * k[c]));
+      }
     }
   }
 }

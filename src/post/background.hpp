@@ -49,7 +49,12 @@ class SkyView {
 void key_transparent(Image& frame, const Image& over_white);
 
 /// As key_transparent, but composites the sky (display-ready: tone-mapped) where the
-/// background shows; `frame` keeps no alpha plane.
-void key_skybox(Image& frame, const Image& over_white, const SkyView& sky);
+/// background shows; `frame` keeps no alpha plane. With `per_channel` (a scene with
+/// transmissive surfaces, whose filter tints what shows through them), each channel takes its
+/// own share w_c = L1_c - L0_c instead of their mean.
+void key_skybox(Image& frame, const Image& over_white, const SkyView& sky, bool per_channel);
+
+/// Whether `scene` draws a transmissive surface (a lit pbr material with transmission > 0).
+bool has_transmission(const Scene& scene);
 
 }  // namespace covrast::detail

@@ -63,7 +63,7 @@ std::string loader_error_message(const std::string& name, std::string text) {
 /// The glTF extensions covrast implements: a file may require these (extensionsRequired).
 /// KHR_mesh_quantization only widens the accessor types of the attributes, which the accessor
 /// reader takes in every type anyway.
-constexpr std::array<std::string_view, 16> kImplementedExtensions = {
+constexpr std::array<std::string_view, 19> kImplementedExtensions = {
     kDracoExtension,
     "EXT_mesh_gpu_instancing",
     "KHR_materials_emissive_strength",
@@ -79,7 +79,10 @@ constexpr std::array<std::string_view, 16> kImplementedExtensions = {
     kClearcoatExtension,
     kSheenExtension,
     kIridescenceExtension,
-    kAnisotropyExtension};
+    kAnisotropyExtension,
+    kTransmissionExtension,
+    kVolumeExtension,
+    kDispersionExtension};
 
 }  // namespace
 

@@ -62,10 +62,12 @@ const std::vector<Field> kPbrFields = {
 /// material.extensions: the material extensions covrast reads are objects (their fields are
 /// checked where they are read, scene/gltf_materials.cpp).
 const std::vector<Field> kMaterialExtensionFields = {
-    {"KHR_materials_ior", Kind::Object},         {"KHR_materials_specular", Kind::Object},
-    {"KHR_materials_clearcoat", Kind::Object},   {"KHR_materials_sheen", Kind::Object},
-    {"KHR_materials_iridescence", Kind::Object}, {"KHR_materials_emissive_strength", Kind::Object},
-    {"KHR_materials_unlit", Kind::Object},       {"KHR_materials_anisotropy", Kind::Object}};
+    {"KHR_materials_ior", Kind::Object},          {"KHR_materials_specular", Kind::Object},
+    {"KHR_materials_clearcoat", Kind::Object},    {"KHR_materials_sheen", Kind::Object},
+    {"KHR_materials_iridescence", Kind::Object},  {"KHR_materials_emissive_strength", Kind::Object},
+    {"KHR_materials_unlit", Kind::Object},        {"KHR_materials_anisotropy", Kind::Object},
+    {"KHR_materials_transmission", Kind::Object}, {"KHR_materials_volume", Kind::Object},
+    {"KHR_materials_dispersion", Kind::Object}};
 
 /// The top-level arrays whose elements covrast reads, and the fields it reads of each.
 struct Section {

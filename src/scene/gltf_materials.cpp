@@ -184,6 +184,32 @@ void read_anisotropy(const ExtensionObject& e, const std::string& name, GltfText
   m.anisotropy_texture = texture(e, "anisotropyTexture", false, textures);
 }
 
+/// KHR_materials_transmission: transmissionFactor (0..1) and transmissionTexture (R, linear).
+void read_transmission(const ExtensionObject& e, const std::string& name, GltfTextures& textures,
+                       Material& m) {
+  m.transmission = static_cast<float>(number_in(e, "transmissionFactor", 0.0, 0.0, 1.0, name));
+  m.transmission_texture = texture(e, "transmissionTexture", false, textures);
+}
+
+/// KHR_materials_volume: thicknessFactor (>= 0, the mesh's units) and thicknessTexture (G),
+/// attenuationDistance (> 0; absent: infinite) and attenuationColor (three numbers in 0..1).
+void read_volume(const ExtensionObject& e, const std::string& name, GltfTextures& textures,
+                 Material& m) {
+  m.thickness = static_cast<float>(number_in(e, "thicknessFactor", 0.0, 0.0, 1e30, name));
+  m.thickness_texture = texture(e, "thicknessTexture", false, textures);
+  if (e.value->Has("attenuationDistance")) {
+    const double distance = number_in(e, "attenuationDistance", 0.0, 0.0, 1e30, name);
+    if (!(distance > 0.0)) fail(name, e.path + ".attenuationDistance: expected a number > 0");
+    m.attenuation_distance = static_cast<float>(distance);
+  }
+  read_unit_color(e, "attenuationColor", name, m.attenuation_color);
+}
+
+/// KHR_materials_dispersion: dispersion (>= 0), kept: without refraction it spreads nothing.
+void read_dispersion(const ExtensionObject& e, const std::string& name, Material& m) {
+  m.dispersion = static_cast<float>(number_in(e, "dispersion", 0.0, 0.0, 1e30, name));
+}
+
 }  // namespace
 
 std::vector<Material> read_materials(const tinygltf::Model& model, GltfTextures& textures,
@@ -234,6 +260,17 @@ void read_material_extensions(const tinygltf::Material& source, int index, GltfT
   if (const ExtensionObject e = find_extension(source, index, kAnisotropyExtension, name);
       e.value) {
     read_anisotropy(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kTransmissionExtension, name);
+      e.value) {
+    read_transmission(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kVolumeExtension, name); e.value) {
+    read_volume(e, name, textures, m);
+  }
+  if (const ExtensionObject e = find_extension(source, index, kDispersionExtension, name);
+      e.value) {
+    read_dispersion(e, name, m);
   }
 }
 

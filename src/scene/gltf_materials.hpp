@@ -26,6 +26,9 @@ inline constexpr std::string_view kClearcoatExtension = "KHR_materials_clearcoat
 inline constexpr std::string_view kSheenExtension = "KHR_materials_sheen";
 inline constexpr std::string_view kIridescenceExtension = "KHR_materials_iridescence";
 inline constexpr std::string_view kAnisotropyExtension = "KHR_materials_anisotropy";
+inline constexpr std::string_view kTransmissionExtension = "KHR_materials_transmission";
+inline constexpr std::string_view kVolumeExtension = "KHR_materials_volume";
+inline constexpr std::string_view kDispersionExtension = "KHR_materials_dispersion";
 
 /// The file's materials as covrast shades them, in file order, then glTF's default material
 /// (for primitives without one): each material's factors (glTF 2.0, 3.9 and 5.19), textures

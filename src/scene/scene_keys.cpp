@@ -25,7 +25,7 @@ constexpr std::array<std::string_view, 4> kEnvironmentKeys = {"file", "builtin",
                                                               "intensity"};
 constexpr std::array<std::string_view, 7> kMeshKeys = {"obj",      "gltf",    "color",  "model",
                                                        "material", "normals", "variant"};
-constexpr std::array<std::string_view, 22> kMaterialKeys = {"model",
+constexpr std::array<std::string_view, 26> kMaterialKeys = {"model",
                                                             "base_color",
                                                             "metallic",
                                                             "roughness",
@@ -46,7 +46,11 @@ constexpr std::array<std::string_view, 22> kMaterialKeys = {"model",
                                                             "iridescence_ior",
                                                             "iridescence_thickness_nm",
                                                             "anisotropy",
-                                                            "anisotropy_rotation_deg"};
+                                                            "anisotropy_rotation_deg",
+                                                            "transmission",
+                                                            "thickness",
+                                                            "attenuation_color",
+                                                            "attenuation_distance"};
 
 /// Levenshtein distance (insertions, deletions, substitutions), one row at a time.
 std::size_t edit_distance(std::string_view a, std::string_view b) {

@@ -19,7 +19,7 @@ ShadingModel SceneReader::shading_model(const json& value, const std::string& pa
 }
 
 /// The keys of the glTF material extensions (KHR_materials_ior, _specular, _clearcoat,
-/// _sheen, _iridescence, _anisotropy).
+/// _sheen, _iridescence, _anisotropy, _transmission, _volume).
 void SceneReader::apply_material_extensions(const json& object, const std::string& key,
                                             Material& m) const {
   if (const auto it = object.find("ior"); it != object.end()) {
@@ -61,6 +61,22 @@ void SceneReader::apply_material_extensions(const json& object, const std::strin
   if (const auto it = object.find("anisotropy_rotation_deg"); it != object.end()) {
     const double degrees = number_in(*it, key + ".anisotropy_rotation_deg", -360.0, 360.0);
     m.anisotropy_rotation = static_cast<float>(degrees * (std::numbers::pi / 180.0));
+  }
+  if (const auto it = object.find("transmission"); it != object.end()) {
+    m.transmission = static_cast<float>(number_in(*it, key + ".transmission", 0.0, 1.0));
+  }
+  if (const auto it = object.find("thickness"); it != object.end()) {
+    m.thickness = static_cast<float>(number_in(*it, key + ".thickness", 0.0, 1e6));
+  }
+  if (const auto it = object.find("attenuation_color"); it != object.end()) {
+    m.attenuation_color = srgb_color(*it, key + ".attenuation_color");
+  }
+  if (const auto it = object.find("attenuation_distance"); it != object.end()) {
+    const double distance = number_in(*it, key + ".attenuation_distance", 0.0, 1e6);
+    if (!(distance > 0.0)) {
+      fail(file_, key + ".attenuation_distance", "expected a number > 0, got " + shown(*it));
+    }
+    m.attenuation_distance = static_cast<float>(distance);
   }
 }
 

@@ -11,6 +11,7 @@
 #include "shading/sheen.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 
@@ -153,10 +154,28 @@ glm::dvec3 pbr_radiance(const SurfaceShading& s, const PbrPoint& m, const glm::d
   for (const PunctualLight& light : s.context->lights) {
     const Incident in = incident(light, p);
     const double n_dot_l = glm::dot(n, in.l);
-    if (!(n_dot_l > 0.0)) continue;
-    sum += pbr_brdf(m, n, v, in.l) * in.irradiance * n_dot_l;
+    if (n_dot_l > 0.0) {
+      sum += pbr_brdf(m, n, v, in.l) * in.irradiance * n_dot_l;
+    } else if (n_dot_l < 0.0 && m.transmits()) {
+      sum += transmission_btdf(m, n, v, in.l) * in.irradiance * -n_dot_l;
+    }
   }
   return sum;
+}
+
+/// KHR_materials_transmission's share of the light behind the surface that passes towards the
+/// viewer (the layer's filter over what lies behind it):
+///   c_trans (1 - (F0_d A_1 + (F90 - F0_d) B_1)),
+/// the transmitted diffuse less the specular's directional albedo under uniform light at
+/// (n . v, roughness) (the split-sum tables, environment_lighting.hpp: the glTF Sample Viewer's
+/// 1 - (f0 brdf.x + f90 brdf.y)). Thin-walled, without refraction: straight through, unblurred.
+glm::dvec3 transmitted_share(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v) {
+  if (!m.transmits()) return glm::dvec3(0.0);
+  if (n == glm::dvec3(0.0)) return m.c_trans;
+  const std::array<double, 3> uniform =
+      uniform_environment_integrals(std::abs(glm::dot(n, v)), m.roughness);
+  const glm::dvec3 albedo = m.f0_diffuse * uniform[1] + (m.f90 - m.f0_diffuse) * uniform[2];
+  return m.c_trans * (glm::dvec3(1.0) - albedo);
 }
 
 /// KHR_materials_clearcoat's layer alone, without its weight clearcoat x Fc: the coat's GGX
@@ -220,9 +239,12 @@ glm::dvec3 sheen_radiance(const SurfaceShading& s, const PbrPoint& m, double alb
 /// coated (KHR_materials_clearcoat, "fresnel_coat"):
 ///   L = L_base (1 - clearcoat Fc) + clearcoat Fc L_coat,  Fc = 0.04 + 0.96 (1 - |n_c . v|)^5,
 /// L_base with the emission (the coat darkens it too).
+/// The layers over the base dim what it transmits as they dim its light: `filter`, when given,
+/// is transmitted_share x the sheen's scaling x (1 - clearcoat Fc).
 glm::dvec3 pbr_shade(const SurfaceShading& s, PbrPoint m, const glm::dvec3& p, const glm::dvec3& n,
-                     const glm::dvec3& v) {
+                     const glm::dvec3& v, glm::dvec3* filter) {
   if (s.iridescence > 0.0 && n != glm::dvec3(0.0)) m.set_iridescence(s, glm::dot(n, v));
+  if (filter != nullptr) *filter = transmitted_share(m, n, v);
   glm::dvec3 base;
   if (m.sheen_color == glm::dvec3(0.0) || n == glm::dvec3(0.0)) {
     base = pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v) + s.emissive;
@@ -232,9 +254,11 @@ glm::dvec3 pbr_shade(const SurfaceShading& s, PbrPoint m, const glm::dvec3& p, c
     const double scaling = 1.0 - strongest * albedo;
     base = (pbr_radiance(s, m, p, n, v) + environment_pbr(s, m, n, v)) * scaling +
            sheen_radiance(s, m, albedo, p, n, v) + s.emissive;
+    if (filter != nullptr) *filter *= scaling;
   }
   if (!(m.clearcoat > 0.0)) return base;
   const double coat = m.clearcoat * clearcoat_fresnel(m.coat_normal, v);
+  if (filter != nullptr) *filter *= 1.0 - coat;
   return base * (1.0 - coat) + clearcoat_radiance(s, m, p, v) * coat;
 }
 
@@ -279,6 +303,20 @@ glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
     fresnel_diffuse = glm::dvec3(strongest) * (1.0 - m.metallic) + metal * m.metallic;
   }
   return (glm::dvec3(1.0) - fresnel_diffuse) * m.c_diff * (1.0 / kPi) + fresnel * lobe.d_vis;
+}
+
+// KHR_materials_transmission's BTDF for a thin wall (the extension's specular_btdf, as the glTF
+// Sample Viewer's getPunctualRadianceTransmission evaluates it): the GGX lobe of the light
+// mirrored through the surface, l' = l - 2 (n . l) n, at the transmission roughness, weighted
+// as the diffuse it replaces is:
+//   f_t = (1 - F_d) c_trans D V (l', v),  F_d at h' = normalize(l' + v).
+glm::dvec3 transmission_btdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
+                             const glm::dvec3& l) {
+  const glm::dvec3 mirrored = l - n * (2.0 * glm::dot(n, l));
+  const GgxLobe lobe = ggx_lobe(n, v, mirrored, m.transmission_alpha2);
+  const double weight = schlick_weight(std::abs(lobe.h_dot_v));
+  const glm::dvec3 fresnel_diffuse = m.f0_diffuse + (m.f90 - m.f0_diffuse) * weight;
+  return (glm::dvec3(1.0) - fresnel_diffuse) * m.c_trans * lobe.d_vis;
 }
 
 glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
@@ -332,6 +370,19 @@ void PbrPoint::set_iridescence(const SurfaceShading& s, double n_dot_v) {
   iridescent_diffuse = glm::dvec3(strongest) * (1.0 - metallic) + over_metal * metallic;
 }
 
+void PbrPoint::set_transmission(const SurfaceShading& s, double transmission, double thickness) {
+  c_trans = c_diff * transmission;
+  c_diff = c_diff * (1.0 - transmission);
+  if (s.attenuation_distance > 0.0 && thickness > 0.0) {
+    const double e = thickness / s.attenuation_distance;
+    c_trans *= glm::dvec3(std::pow(s.attenuation_color.r, e), std::pow(s.attenuation_color.g, e),
+                          std::pow(s.attenuation_color.b, e));
+  }
+  const double alpha = roughness * roughness * std::clamp(2.0 * s.ior - 2.0, 0.0, 1.0);
+  const double clamped = std::max(alpha, kMinBrdfAlpha);
+  transmission_alpha2 = clamped * clamped;
+}
+
 void PbrPoint::set_anisotropy(double strength, const glm::dvec3& direction, const glm::dvec3& n) {
   // The stretched direction made orthogonal to the shading normal, so that t, b, n is the
   // orthonormal frame the anisotropic D assumes (the extension takes T from the interpolated
@@ -346,7 +397,8 @@ void PbrPoint::set_anisotropy(double strength, const glm::dvec3& direction, cons
 
 glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const glm::dvec3& p,
                        const glm::dvec3& n, const glm::dvec3& clearcoat_normal,
-                       const glm::dvec3& anisotropy_direction) {
+                       const glm::dvec3& anisotropy_direction, glm::dvec3* filter) {
+  if (filter != nullptr) *filter = glm::dvec3(0.0);
   const ShadingContext& c = *s.context;
   const glm::dvec3 to_eye = c.eye_world - p;
   const double eye_distance = glm::length(to_eye);
@@ -366,7 +418,8 @@ glm::dvec3 shade_point(const SurfaceShading& s, const glm::dvec3& base, const gl
     default: {
       PbrPoint m(s, base, clearcoat_normal);
       if (s.anisotropy > 0.0) m.set_anisotropy(s.anisotropy, anisotropy_direction, n);
-      return pbr_shade(s, m, p, n, v);
+      if (s.transmission > 0.0) m.set_transmission(s, s.transmission, s.thickness);
+      return pbr_shade(s, m, p, n, v, filter);
     }
   }
 }
@@ -384,10 +437,29 @@ double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double
       r.vertex_alpha[0] == r.vertex_alpha[1] && r.vertex_alpha[0] == r.vertex_alpha[2]
           ? r.vertex_alpha[0]
           : mu0 * r.vertex_alpha[0] + mu1 * r.vertex_alpha[1] + mu2 * r.vertex_alpha[2];
-  return r.surface->base_alpha * vertex * texture_alpha;
+  const double alpha = r.surface->base_alpha * vertex * texture_alpha;
+  // A transmissive OPAQUE or MASK surface is drawn as a BLEND layer (its light passes, not its
+  // alpha): alpha 1, or the mask's verdict.
+  if (r.surface->transmissive() && r.surface->alpha_mode != AlphaMode::Blend) {
+    return r.surface->alpha_mode == AlphaMode::Opaque || alpha >= r.surface->alpha_cutoff ? 1.0
+                                                                                          : 0.0;
+  }
+  return alpha;
+}
+
+bool transmits(const TriangleSetup& t) {
+  return t.shading != nullptr && t.shading->surface->transmissive();
 }
 
 ShadedColor shade_rgba(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside) {
+  if (transmits(t)) {
+    double mu[3];
+    perspective_weights(t, x_px, y_px, clamp_inside, mu);
+    ShadedColor out{glm::vec3(0.0f), surface_alpha(t, mu[0], mu[1], mu[2])};
+    out.rgb = shade_lit(t, mu[0], mu[1], mu[2], nullptr, &out.filter);
+    out.transmissive = true;
+    return out;
+  }
   const glm::vec3 rgb = shade(t, x_px, y_px, clamp_inside);
   if (t.alpha_mode == AlphaMode::Opaque) return {rgb, 1.0};
   double mu[3];
@@ -403,7 +475,7 @@ bool mask_keeps(const TriangleSetup& t, double x_px, double y_px, bool clamp_ins
 }
 
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                    const FragmentFootprint* footprint) {
+                    const FragmentFootprint* footprint, glm::vec3* filter) {
   const ShadingRecord& r = *t.shading;
   // The same weighted sums as the unlit colour interpolation in shade().
   const glm::dvec3 base(mu0 * t.color[0].r + mu1 * t.color[1].r + mu2 * t.color[2].r,
@@ -420,7 +492,15 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
   const auto finish = [&](const glm::dvec3& radiance) {
     return glm::vec3(mapping.is_identity() ? radiance : tone_map(mapping, radiance));
   };
-  if (r.textured == nullptr) return finish(shade_point(*r.surface, base, p, n, n));
+  glm::dvec3 passes(0.0);
+  glm::dvec3* const passes_out = filter != nullptr ? &passes : nullptr;
+  const auto finish_all = [&](const glm::dvec3& radiance) {
+    if (filter != nullptr) *filter = glm::vec3(passes);
+    return finish(radiance);
+  };
+  if (r.textured == nullptr) {
+    return finish_all(shade_point(*r.surface, base, p, n, n, glm::dvec3(0.0), passes_out));
+  }
   // Textured: the surface with this point's texels (shading/texture_shading.cpp).
   const SurfaceSample sample = sample_surface(t, mu0, mu1, mu2, n, footprint);
   SurfaceShading s = *r.surface;
@@ -437,8 +517,10 @@ glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
   s.iridescence = sample.iridescence;
   s.iridescence_thickness_nm = sample.iridescence_thickness_nm;
   s.anisotropy = sample.anisotropy;
-  return finish(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
-                            sample.clearcoat_normal, sample.anisotropy_direction));
+  s.transmission = sample.transmission;
+  s.thickness = sample.thickness;
+  return finish_all(shade_point(s, base * glm::dvec3(sample.base_color), p, sample.normal,
+                                sample.clearcoat_normal, sample.anisotropy_direction, passes_out));
 }
 
 }  // namespace covrast::detail

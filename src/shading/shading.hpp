@@ -15,9 +15,10 @@ struct FragmentFootprint;
 /// to 1): base colour, position and normal interpolated with them (the normal renormalised),
 /// then the material's lighting (shading/shading.cpp). Out of line: it is the slow path.
 /// `footprint`: where the textures are averaged (sample_surface,
-/// shading/shading_inputs.hpp).
+/// shading/shading_inputs.hpp). `filter`, when given, receives the share of the light behind
+/// that the surface passes, per channel (KHR_materials_transmission; 0 for other surfaces).
 glm::vec3 shade_lit(const TriangleSetup& t, double mu0, double mu1, double mu2,
-                    const FragmentFootprint* footprint = nullptr);
+                    const FragmentFootprint* footprint = nullptr, glm::vec3* filter = nullptr);
 
 /// The perspective-correct barycentric weights mu0..mu2 of `t` at (x_px, y_px). With
 /// `clamp_inside`, the screen barycentrics are clamped to [0, 1] first, so a point outside the
@@ -76,14 +77,24 @@ double surface_alpha(const TriangleSetup& t, double mu0, double mu1, double mu2)
 double surface_alpha_with(const TriangleSetup& t, double mu0, double mu1, double mu2,
                           double texture_alpha);
 
-/// Colour and alpha of a shading point.
+/// Colour and alpha of a shading point, and what its covered part passes of the light behind
+/// it (KHR_materials_transmission's filter, per channel; 0 for every other surface). As a layer
+/// (shading/composite.hpp) it adds alpha x rgb and passes (1 - alpha) + alpha x filter.
 struct ShadedColor {
   glm::vec3 rgb;
   double alpha;
+  glm::vec3 filter{0.0f};
+  /// Of a transmissive surface: where its alpha is > 0, only the opaque scene shows through it
+  /// (the layers behind it are skipped: shading/composite.hpp).
+  bool transmissive = false;
 };
 
+/// Whether `t`'s surface is transmissive (its layers have a filter; shading_inputs.hpp).
+bool transmits(const TriangleSetup& t);
+
 /// Colour and alpha of `t` at (x_px, y_px), with the same weights as shade(): opaque
-/// triangles are shade() and alpha 1, so their colour path is untouched. Out of line.
+/// triangles are shade() and alpha 1, so their colour path is untouched; a transmissive one's
+/// filter too. Out of line.
 ShadedColor shade_rgba(const TriangleSetup& t, double x_px, double y_px, bool clamp_inside);
 
 /// Whether a Mask triangle keeps the point (x_px, y_px): alpha >= cutoff. True for Opaque

@@ -67,6 +67,8 @@ struct SurfaceTextures {
   const TextureSlot* iridescence = nullptr;            ///< KHR_materials_iridescence, R
   const TextureSlot* iridescence_thickness = nullptr;  ///< KHR_materials_iridescence, G
   const TextureSlot* anisotropy = nullptr;  ///< KHR_materials_anisotropy: RG direction, B strength
+  const TextureSlot* transmission = nullptr;  ///< KHR_materials_transmission, R
+  const TextureSlot* thickness = nullptr;     ///< KHR_materials_volume, G
 };
 
 /// The fragment over which sample_surface averages its textures
@@ -118,6 +120,17 @@ struct SurfaceShading {
   double anisotropy = 0.0;
   glm::dvec2 anisotropy_rotation{1.0, 0.0};
   bool anisotropic() const { return model == ShadingModel::Pbr && anisotropy > 0.0; }
+  /// pbr, KHR_materials_transmission: the share of the diffuse that passes (0: none); with
+  /// KHR_materials_volume the thickness [world units: the material's x the instance's scale]
+  /// and the attenuation over it (distance 0: none).
+  double transmission = 0.0;
+  double ior = 1.5;  ///< KHR_materials_ior's, for the transmission lobe's roughness
+  double thickness = 0.0;
+  glm::dvec3 attenuation_color{1.0};
+  double attenuation_distance = 0.0;
+  /// A pbr surface with transmission (some texel may give it): its triangles are composited
+  /// as transparent layers, their alpha 1 (OPAQUE) or the mask's verdict (MASK).
+  bool transmissive() const { return model == ShadingModel::Pbr && transmission > 0.0; }
   /// Alpha (docs/transparency.md): base_alpha x vertex alpha x texture alpha at the point.
   AlphaMode alpha_mode = AlphaMode::Opaque;
   double alpha_cutoff = 0.5;  ///< Mask: kept where alpha >= alpha_cutoff
@@ -172,6 +185,8 @@ struct SurfaceSample {
   /// unit, world space: the direction the anisotropic lobe is stretched along (zero: no
   /// tangent frame here, the lobe is the isotropic one)
   glm::dvec3 anisotropy_direction{0.0};
+  double transmission = 0.0;  ///< the surface's, times the transmission texture's R
+  double thickness = 0.0;     ///< the surface's, times the thickness texture's G
 };
 
 /// Samples every texture of `t`'s surface at the perspective-correct weights mu0..mu2, with
@@ -207,9 +222,12 @@ WeightDerivatives weight_derivatives(const TriangleSetup& t, double mu0, double 
 /// base colour `base` (linear): the material's model, summed over the context's lights.
 /// `clearcoat_normal` (unit, or zero) is the pbr clear coat's normal (KHR_materials_clearcoat).
 /// `anisotropy_direction` (unit, or zero: isotropic) is KHR_materials_anisotropy's direction.
+/// `filter`, when given, receives what the surface passes of the light behind it, per channel
+/// (KHR_materials_transmission; 0 for every other surface).
 glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base, const glm::dvec3& p,
                        const glm::dvec3& n, const glm::dvec3& clearcoat_normal,
-                       const glm::dvec3& anisotropy_direction = glm::dvec3(0.0));
+                       const glm::dvec3& anisotropy_direction = glm::dvec3(0.0),
+                       glm::dvec3* filter = nullptr);
 inline glm::dvec3 shade_point(const SurfaceShading& surface, const glm::dvec3& base,
                               const glm::dvec3& p, const glm::dvec3& n) {
   return shade_point(surface, base, p, n, n);
@@ -246,6 +264,15 @@ struct PbrPoint {
   double anisotropy = 0.0;
   glm::dvec3 anisotropy_t{0.0}, anisotropy_b{0.0};
   void set_anisotropy(double strength, const glm::dvec3& direction, const glm::dvec3& n);
+  /// KHR_materials_transmission (set by set_transmission): c_trans = base (1 - metallic)
+  /// transmission, the part of the dielectric's diffuse that passes instead (c_diff keeps
+  /// 1 - transmission of it), times KHR_materials_volume's attenuation over the thickness,
+  /// attenuation_color^(thickness / attenuation_distance); and the BTDF's alpha^2, from
+  /// alpha x clamp(2 ior - 2, 0, 1) (the glTF Sample Viewer's applyIorToRoughness).
+  glm::dvec3 c_trans{0.0};
+  double transmission_alpha2 = 0.0;
+  bool transmits() const { return c_trans != glm::dvec3(0.0); }
+  void set_transmission(const SurfaceShading& s, double transmission, double thickness);
 };
 
 /// The glTF 2.0 metallic-roughness BRDF f(l, v) (specification, Appendix B.3.5: Trowbridge-
@@ -256,5 +283,9 @@ glm::dvec3 pbr_brdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
                     const glm::dvec3& l);
 glm::dvec3 pbr_brdf(const glm::dvec3& base, double metallic, double roughness, const glm::dvec3& n,
                     const glm::dvec3& v, const glm::dvec3& l);
+/// KHR_materials_transmission's thin-walled BTDF for a light in direction l behind the surface
+/// (n . l < 0), without the cosine (shading/shading.cpp). Exposed for the tests.
+glm::dvec3 transmission_btdf(const PbrPoint& m, const glm::dvec3& n, const glm::dvec3& v,
+                             const glm::dvec3& l);
 
 }  // namespace covrast::detail

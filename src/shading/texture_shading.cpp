@@ -199,9 +199,10 @@ void sample_anisotropy(const TriangleSetup& t, const SurfaceShading& s,
 
 /// The textures of KHR_materials_specular (strength in A, F0 colour in RGB),
 /// KHR_materials_iridescence (strength in R, thickness in G: mix(minimum, maximum, G)),
-/// KHR_materials_sheen (colour in RGB, roughness in A) and KHR_materials_clearcoat (weight in R,
-/// roughness in G, its own normal map, which perturbs the interpolated normal, not the base's
-/// mapped one); each multiplies the surface's factor.
+/// KHR_materials_sheen (colour in RGB, roughness in A), KHR_materials_transmission (R),
+/// KHR_materials_volume (thickness in G) and KHR_materials_clearcoat (weight in R, roughness in
+/// G, its own normal map, which perturbs the interpolated normal, not the base's mapped one);
+/// each multiplies the surface's factor.
 void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
                                 const SurfaceTextures& slots, const TexturedCorners& corners,
                                 const double mu[3], const WeightDerivatives& d,
@@ -231,6 +232,10 @@ void sample_material_extensions(const TriangleSetup& t, const SurfaceShading& s,
   if (slots.sheen_roughness != nullptr) {
     out.sheen_roughness *= lookup(t, *slots.sheen_roughness, corners, mu, d, footprint).a;
   }
+  if (slots.transmission != nullptr)
+    out.transmission *= lookup(t, *slots.transmission, corners, mu, d, footprint).r;
+  if (slots.thickness != nullptr)
+    out.thickness *= lookup(t, *slots.thickness, corners, mu, d, footprint).g;
   if (slots.clearcoat_normal != nullptr && out.clearcoat_normal != glm::dvec3(0.0)) {
     out.clearcoat_normal =
         perturbed_normal(lookup(t, *slots.clearcoat_normal, corners, mu, d, footprint),
@@ -289,6 +294,8 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.iridescence = s.iridescence;
   out.iridescence_thickness_nm = s.iridescence_thickness_nm;
   out.anisotropy = s.anisotropy;
+  out.transmission = s.transmission;
+  out.thickness = s.thickness;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
   // One tangent frame per point, of the interpolated normal: the normal map's, the clearcoat

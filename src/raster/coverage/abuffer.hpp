@@ -166,18 +166,34 @@ class ABufferTile {
   /// What the transparent fragments in front leave of each opaque contributor of a pixel
   /// (a triangle, or null for the background): the mean transmittance over the samples where
   /// it is the nearest opaque surface; `fallback` (the pixel's mean) for one that owns none.
+  /// Per channel: a transmissive fragment's filter tints what it passes.
   struct Transmittance {
     int n = 0;
     const TriangleSetup* who[kMaskSamples + 1];
-    double keep[kMaskSamples + 1];
-    double fallback = 1.0;
-    double of(const TriangleSetup* t) const {
+    glm::dvec3 keep[kMaskSamples + 1];
+    glm::dvec3 fallback{1.0};
+    glm::dvec3 of(const TriangleSetup* t) const {
       for (int k = 0; k < n; ++k) {
         if (who[k] == t) return keep[k];
       }
       return fallback;
     }
   };
+  /// rgb += w x c, times what `tr` (when given) keeps of contributor t: the opaque resolve's
+  /// one weighted sum, with the same operations as without transparency where tr is null.
+  static void add_kept(double rgb[3], double w, const Transmittance* tr, const TriangleSetup* t,
+                       glm::vec3 c) {
+    if (tr == nullptr) {
+      rgb[0] += w * c.r;
+      rgb[1] += w * c.g;
+      rgb[2] += w * c.b;
+      return;
+    }
+    const glm::dvec3 keep = tr->of(t);
+    rgb[0] += w * keep.r * c.r;
+    rgb[1] += w * keep.g * c.g;
+    rgb[2] += w * keep.b * c.b;
+  }
   /// One triangle's piece of a pixel: 16 bytes, so a tile's lists stay in cache.
   struct Fragment {
     const TriangleSetup* triangle;  ///< when merged: the piece whose plane stands for all
@@ -348,9 +364,9 @@ class ABufferTile {
                             const Transmittance& tr) const;
   /// The common case of resolve_transparent: every transparent fragment covers the pixel,
   /// lies in front of every opaque contributor all over it, and no two of them cross there.
-  /// Then `transmit` = prod (1 - alpha_j) and `light` = sum_j alpha_j c_j prod_{i < j} (1 -
-  /// alpha_i), nearest first; false otherwise.
-  bool uniform_transparency(std::size_t pixel, int x, int y, double& transmit,
+  /// Then `transmit` = prod_j pass_j and `light` = sum_j alpha_j c_j prod_{i < j} pass_i,
+  /// nearest first, pass_j = (1 - alpha_j) + alpha_j filter_j (composite.hpp); false otherwise.
+  bool uniform_transparency(std::size_t pixel, int x, int y, glm::dvec3& transmit,
                             glm::dvec3& light) const;
   /// The pixel's opaque resolve with each contributor weighted by tr.of(contributor).
   glm::vec3 opaque_through(std::size_t pixel, int x, int y, glm::vec3 background, float& depth,

@@ -169,8 +169,6 @@ struct ABufferTile::ListFragments {
   glm::vec3 color(int i, int x, int y) const {
     return merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
   }
-  /// What the transparent fragments in front leave of fragment i (1: none, `tr` null).
-  double kept(const Transmittance* tr, int i) const { return tr != nullptr ? tr->of(tri[i]) : 1.0; }
 };
 
 void ABufferTile::gather_list(std::size_t pixel, int x, int y, ListFragments& l,
@@ -220,12 +218,8 @@ glm::vec3 ABufferTile::list_layer_color(const ListFragments& l, const bool* memb
   LayerSums sums{0, {0.0, 0.0, 0.0}, depth, 0.0, kNoConvexKey};
   for (int i = 0; i < l.n; ++i) {
     if (member != nullptr && !member[i]) continue;
-    const glm::vec3 c = l.color(i, x, y);
-    const double w = double(l.cov[i]) * l.kept(tr, i);
     sums.coverage += l.cov[i];
-    sums.rgb[0] += w * c.r;
-    sums.rgb[1] += w * c.g;
-    sums.rgb[2] += w * c.b;
+    add_kept(sums.rgb, double(l.cov[i]), tr, l.tri[i], l.color(i, x, y));
   }
   return front_layer_color(sums, behind);
 }
@@ -262,16 +256,12 @@ glm::vec3 ABufferTile::list_weighted_color(const ListFragments& l, const double*
   }
   const double scale = total > 1.0 ? 1.0 / total : 1.0;
   const double rest = total > 1.0 ? 0.0 : 1.0 - total;
-  double r = rest * behind.r, g = rest * behind.g, b = rest * behind.b;
+  double rgb[3] = {rest * behind.r, rest * behind.g, rest * behind.b};
   for (int i = 0; i < l.n; ++i) {
     if (weight[i] == 0) continue;
-    const glm::vec3 c = l.color(i, x, y);
-    double w = weight[i] * scale * l.kept(tr, i);
-    r += w * c.r;
-    g += w * c.g;
-    b += w * c.b;
+    add_kept(rgb, weight[i] * scale, tr, l.tri[i], l.color(i, x, y));
   }
-  return glm::vec3(float(r), float(g), float(b));
+  return glm::vec3(float(rgb[0]), float(rgb[1]), float(rgb[2]));
 }
 
 glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 background,
@@ -279,7 +269,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   const TriangleSetup* opaque = opaque_[pixel];
   glm::vec3 behind = opaque_pixel(opaque, x, y, background, depth);
   // Seen through transparent fragments: each opaque contributor times what they leave of it.
-  if (tr != nullptr) behind *= float(tr->of(opaque));
+  if (tr != nullptr) behind *= glm::vec3(tr->of(opaque));
   // The path this pixel takes, counted for the opaque resolve (a transparent pixel is
   // counted once, by resolve()).
   const auto took = [&](std::uint64_t CoverageResolvePaths::*path) {

@@ -136,16 +136,12 @@ glm::vec3 ABufferTile::resolve_samples(std::size_t pixel, int x, int y, glm::vec
   }
   const double background_share = double(background_won) / kMaskSamples;
   const double scale = total > 0.0 ? (1.0 - background_share) / total : 0.0;
-  if (tr != nullptr) background *= float(tr->of(nullptr));
-  double r = background_share * background.r, g = background_share * background.g,
-         b = background_share * background.b;
+  if (tr != nullptr) background *= glm::vec3(tr->of(nullptr));
+  double rgb[3] = {background_share * background.r, background_share * background.g,
+                   background_share * background.b};
   for (int k = 0; k < winners; ++k) {
-    const glm::vec3 c = shade_fragment(*winner[k], x, y);
-    const double w = weight[k] * scale * (tr != nullptr ? tr->of(winner[k]) : 1.0);
-    r += w * c.r;
-    g += w * c.g;
-    b += w * c.b;
+    add_kept(rgb, weight[k] * scale, tr, winner[k], shade_fragment(*winner[k], x, y));
   }
-  return glm::vec3(float(r), float(g), float(b));
+  return glm::vec3(float(rgb[0]), float(rgb[1]), float(rgb[2]));
 }
 }  // namespace covrast::detail

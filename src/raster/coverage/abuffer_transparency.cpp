@@ -8,12 +8,15 @@
 // - j runs over the transparent fragments, area_j its exact coverage (the kernel's 8.8
 //   value), alpha_j and c_j its alpha and colour at the pixel centre clamped into it (as
 //   shading), S_j the mean over the 256 mask samples it covers of V_j(s) T_j(s): V_j(s) = 1
-//   where it is nearer than the nearest opaque surface at s, T_j(s) = prod (1 - alpha_i)
-//   over the transparent fragments i nearer than it at s (ties: lower primitive index first).
+//   where it is nearer than the nearest opaque surface at s and behind no transmissive
+//   fragment with alpha > 0 (composite.hpp, ends_layers), T_j(s) = prod pass_i over the
+//   transparent fragments i nearer than it at s (ties: lower primitive index first), pass_i =
+//   (1 - alpha_i) + alpha_i filter_i per channel (shading/composite.hpp: a transmissive
+//   fragment's filter tints what it passes; 0 for every other one).
 //   The front fragment of a stack has S_j = 1 and keeps its exact area.
 // - o runs over the opaque contributors (opaque fragments, the pixel's opaque surface, the
 //   background), W_o their weights from the opaque resolve, keep_o the mean over the samples
-//   where o is the nearest opaque surface of T(s) = prod (1 - alpha_i) over every transparent
+//   where o is the nearest opaque surface of T(s) = prod pass_i over every transparent
 //   fragment in front of it there.
 // A fragment too thin to own a sample is judged at one point inside its part of the pixel.
 // Everything is per pixel and sorted by depth, so draw order does not matter.
@@ -35,9 +38,11 @@ struct ABufferTile::Clear {
   double area;   ///< exact coverage [pixels]
   double alpha;  ///< at the shading point
   glm::vec3 rgb;
+  glm::dvec3 pass;   ///< (1 - alpha) + alpha filter
+  bool ends_layers;  ///< transmissive: only the opaque scene shows behind it (composite.hpp)
   SampleMask mask;
-  int owned;         ///< samples in mask
-  double shown = 0;  ///< sum over its samples of V T (then the mean S)
+  int owned;              ///< samples in mask
+  glm::dvec3 shown{0.0};  ///< sum over its samples of V T (then the mean S)
 };
 
 void ABufferTile::add_transparent(int x, int y, const TriangleSetup* t, std::uint32_t coverage,
@@ -92,7 +97,7 @@ void ABufferTile::opaque_samples(std::size_t pixel, int x, int y, double* z,
   }
 }
 
-bool ABufferTile::uniform_transparency(std::size_t pixel, int x, int y, double& transmit,
+bool ABufferTile::uniform_transparency(std::size_t pixel, int x, int y, glm::dvec3& transmit,
                                        glm::dvec3& light) const {
   if (layer_[pixel] == Layer::Sampled) return false;
   // The nearest any opaque contributor gets in the pixel.
@@ -137,7 +142,7 @@ glm::vec3 ABufferTile::opaque_through(std::size_t pixel, int x, int y, glm::vec3
   const TriangleSetup* o = opaque_[pixel];
   depth =
       o != nullptr ? float(o->depth_at(x + 0.5, y + 0.5)) : std::numeric_limits<float>::infinity();
-  return (o != nullptr ? shade_fragment(*o, x, y) : background) * float(tr.of(o));
+  return (o != nullptr ? shade_fragment(*o, x, y) : background) * glm::vec3(tr.of(o));
 }
 
 void ABufferTile::transmittance_by_samples(std::vector<Clear>& clear, int x, int y,
@@ -148,7 +153,7 @@ void ABufferTile::transmittance_by_samples(std::vector<Clear>& clear, int x, int
   plane.clear();
   for (const Clear& c : clear) plane.emplace_back(*c.t, x, y);
   // Per sample: the transparent fragments in front of the opaque surface, nearest first.
-  double sum_t[kMaskSamples + 1], total_t = 0.0;
+  glm::dvec3 sum_t[kMaskSamples + 1], total_t(0.0);
   int count[kMaskSamples + 1];
   thread_local std::vector<std::pair<double, int>> stack;
   for (int k = 0; k < kMaskSamples; ++k) {
@@ -161,24 +166,25 @@ void ABufferTile::transmittance_by_samples(std::vector<Clear>& clear, int x, int
     std::sort(stack.begin(), stack.end(), [&](const auto& a, const auto& b) {
       return nearer_first(a.first, *clear[a.second].t, b.first, *clear[b.second].t);
     });
-    double t = 1.0;
+    glm::dvec3 t(1.0);
     for (const auto& [z, j] : stack) {
       clear[j].shown += t;
-      t *= 1.0 - clear[j].alpha;
+      t *= clear[j].pass;
+      if (clear[j].ends_layers) break;
     }
     total_t += t;
     int slot = 0;
     while (slot < tr.n && tr.who[slot] != id[k]) ++slot;
     if (slot == tr.n) {
       tr.who[tr.n++] = id[k];
-      sum_t[slot] = 0.0;
+      sum_t[slot] = glm::dvec3(0.0);
       count[slot] = 0;
     }
     sum_t[slot] += t;
     ++count[slot];
   }
-  for (int s = 0; s < tr.n; ++s) tr.keep[s] = sum_t[s] / count[s];
-  tr.fallback = total_t / kMaskSamples;
+  for (int s = 0; s < tr.n; ++s) tr.keep[s] = sum_t[s] / double(count[s]);
+  tr.fallback = total_t / double(kMaskSamples);
 }
 
 void ABufferTile::sliver_transmittance(std::size_t pixel, int x, int y, std::vector<Clear>& clear,
@@ -202,13 +208,15 @@ void ABufferTile::sliver_transmittance(std::size_t pixel, int x, int y, std::vec
         o != nullptr && layer_[pixel] != Layer::Sampled && !(zj < o->depth_at(px, py))) {
       visible = false;
     }
-    double t = 1.0;
+    glm::dvec3 t(1.0);
     for (int i = 0; i < n && visible; ++i) {
       if (i == j || !covers_point(*clear[i].t, px, py)) continue;
-      if (nearer_first(clear[i].t->depth_at(px, py), *clear[i].t, zj, *c.t))
-        t *= 1.0 - clear[i].alpha;
+      if (nearer_first(clear[i].t->depth_at(px, py), *clear[i].t, zj, *c.t)) {
+        t *= clear[i].pass;
+        visible = !clear[i].ends_layers;  // behind a transmissive layer
+      }
     }
-    c.shown = visible ? t : 0.0;
+    c.shown = visible ? t : glm::dvec3(0.0);
     c.owned = 1;
   }
 }
@@ -216,7 +224,7 @@ void ABufferTile::sliver_transmittance(std::size_t pixel, int x, int y, std::vec
 glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,
                                            float& depth) {
   Transmittance tr;
-  double transmit;
+  glm::dvec3 transmit;
   glm::dvec3 light;
   if (!testing::coverage_hooks.mask_resolve.load(std::memory_order_relaxed) &&
       uniform_transparency(pixel, x, y, transmit, light)) {
@@ -236,8 +244,9 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
     const TriangleSetup* t = transparent_pool_[f].triangle;
     const ShadedColor c = shade_fragment_rgba(*t, x, y);
     const SampleMask mask = pixel_sample_mask(*t, x, y);
-    clear.push_back(Clear{t, double(transparent_pool_[f].coverage) / kCoverageOne,
-                          std::clamp(c.alpha, 0.0, 1.0), c.rgb, mask, mask.count()});
+    const double alpha = std::clamp(c.alpha, 0.0, 1.0);
+    clear.push_back(Clear{t, double(transparent_pool_[f].coverage) / kCoverageOne, alpha, c.rgb,
+                          passes(alpha, c.filter), ends_layers(c, alpha), mask, mask.count()});
   }
   transmittance_by_samples(clear, x, y, z_opaque, id, tr);
   sliver_transmittance(pixel, x, y, clear, tr);  // the fragments without a sample
@@ -245,10 +254,10 @@ glm::vec3 ABufferTile::resolve_transparent(std::size_t pixel, int x, int y, glm:
   const glm::vec3 opaque_part = opaque_through(pixel, x, y, background, depth, tr);
   double r = opaque_part.r, g = opaque_part.g, b = opaque_part.b;
   for (const Clear& c : clear) {
-    const double w = c.area * c.alpha * (c.shown / c.owned);
-    r += w * c.rgb.r;
-    g += w * c.rgb.g;
-    b += w * c.rgb.b;
+    const double w = c.area * c.alpha;
+    r += w * (c.shown.r / c.owned) * c.rgb.r;
+    g += w * (c.shown.g / c.owned) * c.rgb.g;
+    b += w * (c.shown.b / c.owned) * c.rgb.b;
   }
   return glm::vec3(float(r), float(g), float(b));
 }

@@ -188,7 +188,8 @@ class CoverageRasterizer final : public TileRasterizer {
         coverage_to_alpha8(coverage) / 255.0f *
         (t.alpha_mode == AlphaMode::Blend ? float(std::clamp(c.alpha, 0.0, 1.0)) : 1.0f);
     const glm::vec3 dst = color_[i].r < 0.0f ? background_ : color_[i];
-    color_[i] = alpha * c.rgb + (1.0f - alpha) * dst;
+    // A transmissive layer also passes filter x alpha of what is behind (0 for the others).
+    color_[i] = alpha * c.rgb + (1.0f - alpha) * dst + alpha * c.filter * dst;
     if (t.alpha_mode == AlphaMode::Mask) depth_[i] = z;
   }
 

@@ -135,6 +135,20 @@ ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
     }
     return {shade_fragment(t, x, y), share.share};
   }
+  if (transmits(t)) {
+    // shade_fragment's shading with the filter: the textures averaged over the fragment.
+    double mu[3];
+    perspective_weights(t, x + 0.5, y + 0.5, true, mu);
+    ShadedColor out{glm::vec3(0.0f), surface_alpha(t, mu[0], mu[1], mu[2])};
+    if (t.shading->surface->has_texture_slots) {
+      const FragmentFootprint footprint = footprint_of(t, x, y);
+      out.rgb = shade_lit(t, mu[0], mu[1], mu[2], &footprint, &out.filter);
+    } else {
+      out.rgb = shade_lit(t, mu[0], mu[1], mu[2], nullptr, &out.filter);
+    }
+    out.transmissive = true;
+    return out;
+  }
   const glm::vec3 rgb = shade_fragment(t, x, y);
   if (t.alpha_mode != AlphaMode::Blend) return {rgb, 1.0};
   double mu[3];

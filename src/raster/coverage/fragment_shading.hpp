@@ -55,7 +55,8 @@ MaskShare mask_share(const TriangleSetup& t, int x, int y);
 /// The colour and alpha coverage mode gives the fragment of a MASK or BLEND triangle (the
 /// A-buffer's transparent list holds both). BLEND: the colour of shade_fragment, the surface
 /// alpha at the clamped centre. MASK: where it straddles the cutoff, mask_share's share as
-/// alpha, and the shading at its centroid with its mean base colour texel; else opaque.
+/// alpha, and the shading at its centroid with its mean base colour texel; else opaque. A
+/// transmissive surface's fragment (a BLEND layer) carries its filter too.
 ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y);
 
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
