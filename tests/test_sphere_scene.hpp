@@ -19,10 +19,11 @@
 
 namespace covrast::test {
 
-/// A 96 x 96 lit scene of the unit sphere (96 x 192 quads, exact normals: the positions) with
-/// base colour `base` and `material`, seen from `eye` towards the origin, fovy 40, no lights.
+/// A 96 x 96 lit scene of the unit sphere (`rings` x 2 `rings` quads, exact normals: the
+/// positions) with base colour `base` and `material`, seen from `eye` towards the origin, fovy
+/// 40, no lights.
 inline Scene lit_sphere_scene(const glm::vec3& base, const Material& material,
-                              const glm::dvec3& eye = {0.0, 0.0, 3.0}) {
+                              const glm::dvec3& eye = {0.0, 0.0, 3.0}, int rings = 96) {
   Scene scene;
   scene.width = scene.height = 96;
   scene.camera.eye = eye;
@@ -30,7 +31,7 @@ inline Scene lit_sphere_scene(const glm::vec3& base, const Material& material,
   scene.camera.fovy_deg = 40.0;
   scene.camera.near = 0.5;
   scene.camera.far = 10.0;
-  auto sphere = uv_sphere(96, 192);
+  auto sphere = uv_sphere(rings, 2 * rings);
   std::vector<glm::vec3> normals;
   for (const std::uint32_t i : sphere->indices) normals.push_back(sphere->positions[i]);
   analyze_mesh_topology(*sphere);

@@ -239,7 +239,14 @@ TEST_CASE("through a transmissive surface only the opaque scene shows: one wall 
   for (const char* mode : {"coverage", "aliased", "msaa:4", "ssaa:4", "reference"}) {
     INFO(mode);
     const auto render = [&](const Transmissive& c) {
-      return covrast::test::render_mode(transmissive_sphere(base, c), mode);
+      // A coarse sphere, and a small image for the exact reference (4096 shaded samples a
+      // pixel): the property holds for any closed shell at any size.
+      covrast::Scene scene =
+          covrast::test::lit_sphere_scene(glm::vec3(base), c.material, {0.0, 0.0, 3.0}, 12);
+      if (std::string(mode) == "reference") scene.width = scene.height = 32;
+      scene.background_linear = glm::vec3(kBackground);
+      covrast::test::light_sun_and_sky(scene, -c.to_sun, kSun, kSky);
+      return covrast::test::render_mode(scene, mode);
     };
     CHECK(covrast::test::max_difference(render(shell), render(single)) <= 1);
     CHECK(covrast::test::max_difference(render(blend), render(blend_single)) > 10);

@@ -6,6 +6,7 @@
 #include "binning/tile_bins.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 namespace covrast::detail {
 namespace {
@@ -99,6 +100,56 @@ void bin_chunk(const TileGrid& grid, std::span<const PixelBounds16> bounds, Chun
         return PixelRect{b.x0, b.y0, b.x1, b.y1};
       },
       bins, scratch);
+}
+
+namespace {
+
+/// The sort key of `t`: the top 24 bits of its nearest depth as a float (>= +0, so the bits
+/// order as the values do; about 5 significant decimal digits).
+std::uint32_t nearest_depth_key(const TriangleSetup& t) {
+  const double s = 1.0 / kSubpixelOne;
+  double z = t.depth_at(t.x_fx8[0] * s, t.y_fx8[0] * s);
+  z = std::min(z, t.depth_at(t.x_fx8[1] * s, t.y_fx8[1] * s));
+  z = std::min(z, t.depth_at(t.x_fx8[2] * s, t.y_fx8[2] * s));
+  const float nearest = float(z) > 0.0f ? float(z) : 0.0f;  // -0, NaN: 0
+  std::uint32_t bits;
+  std::memcpy(&bits, &nearest, sizeof bits);
+  return bits >> 8;
+}
+
+/// Sorts `keys` (key << 32 | submission index, all distinct) ascending: an LSD radix sort of
+/// the 24-bit keys, three stable passes of 8 bits, which gives the same order as comparing the
+/// whole values (ties in index order) in linear time; a comparison sort for short tiles.
+void sort_keys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& other) {
+  if (keys.size() < 256) {
+    std::sort(keys.begin(), keys.end());
+    return;
+  }
+  other.resize(keys.size());
+  for (int shift = 32; shift < 56; shift += 8) {
+    std::uint32_t start[257] = {};
+    for (const std::uint64_t k : keys) ++start[((k >> shift) & 0xff) + 1];
+    for (int d = 0; d < 256; ++d) start[d + 1] += start[d];
+    for (const std::uint64_t k : keys) other[start[(k >> shift) & 0xff]++] = k;
+    keys.swap(other);
+  }
+}
+
+}  // namespace
+
+void sort_nearest_first(std::vector<const TriangleSetup*>& triangles,
+                        std::vector<std::uint64_t>& keys) {
+  keys.clear();
+  for (std::size_t i = 0; i < triangles.size(); ++i) {
+    keys.push_back(std::uint64_t(nearest_depth_key(*triangles[i])) << 32 | std::uint64_t(i));
+  }
+  thread_local std::vector<std::uint64_t> other;
+  sort_keys(keys, other);
+  // The permutation: each key's low half is its triangle's old position.
+  thread_local std::vector<const TriangleSetup*> sorted;
+  sorted.resize(triangles.size());
+  for (std::size_t k = 0; k < keys.size(); ++k) sorted[k] = triangles[keys[k] & 0xffffffffu];
+  triangles.swap(sorted);
 }
 
 }  // namespace covrast::detail

@@ -54,4 +54,16 @@ struct ChunkBins {
 void bin_chunk(const TileGrid& grid, std::span<const PixelBounds16> bounds, ChunkBins& bins,
                std::vector<std::uint32_t>& scratch);
 
+/// Coverage mode's draw order for one tile: `triangles` (in submission order) reordered
+/// nearest first, by the least window depth of each triangle's plane at its three vertices
+/// (the plane is linear, so that is its nearest point) rounded to a float's top 24 bits; equal
+/// keys keep submission order, so the order is a total one that every tile and thread count
+/// shares.
+/// Why nearest first: the A-buffer drops what lies behind a proven layer or closed set as it
+/// arrives, and skips a triangle hidden all over its box before its area kernel runs
+/// (docs/coverage.md, section 2, "Draw order"); what arrives before its occluder is logged,
+/// masked and resolved instead. `keys` is scratch, reused between calls.
+void sort_nearest_first(std::vector<const TriangleSetup*>& triangles,
+                        std::vector<std::uint64_t>& keys);
+
 }  // namespace covrast::detail

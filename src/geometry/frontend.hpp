@@ -217,6 +217,17 @@ class GeometryFrontEnd {
   void setup_chunk(std::uint32_t chunk, ChunkSetups& out, std::vector<PixelBounds16>& bounds,
                    SetupCounters& counters) const;
 
+  /// Whether every instance is a convex surface (convex_surface): no triangle can hide another
+  /// of its own mesh, only other instances can, and coverage mode keeps submission order (on
+  /// the sphere grid its nearest-first order cost more than it saved; binning/tile_bins.hpp,
+  /// sort_nearest_first).
+  bool every_instance_convex() const {
+    for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
+      if (!convex_surface(i)) return false;
+    }
+    return true;
+  }
+
  private:
   /// The viewport transform and 24.8 snap of a clip position (frontend_stages.hpp).
   SnappedVertex snap(const glm::dvec4& clip) const;

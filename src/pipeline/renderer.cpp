@@ -105,6 +105,9 @@ struct Renderer::Impl {
   int threads;
   detail::TileGrid grid;
   detail::GeometryFrontEnd front_end;
+  /// Coverage mode draws each tile nearest first, unless every instance is a convex surface
+  /// (set per frame by set_up_triangles; the same for every tile, so tiles agree on the order).
+  bool nearest_first = false;
   /// Every chunk's set-up triangles, chunk c in its slice from triangle c * kTrianglesPerChunk:
   /// one allocation, so that a first frame faults it in as a few huge pages rather than
   /// ~7000 small ones (one frame per process is the usual command-line use).
@@ -157,8 +160,13 @@ struct Renderer::Impl {
   /// Raster and resolve, one task per range of tiles, each tile drawn from start to end by
   /// one worker's rasterizer.
   void raster_tiles(const detail::FrameTarget& target);
-  /// One tile: its triangles in submission order (chunk by chunk), then the resolve.
+  /// One tile: its triangles (coverage: nearest first; the other modes in submission order,
+  /// chunk by chunk), then the resolve.
   void raster_tile(detail::TileRasterizer& raster, int tile, const detail::FrameTarget& target);
+  void draw_in_submission_order(detail::TileRasterizer& raster, int tile);
+  /// binning/tile_bins.hpp, sort_nearest_first: the A-buffer then drops what its proven
+  /// layers and closed sets hide as it arrives.
+  void draw_nearest_first(detail::TileRasterizer& raster, int tile);
   /// When each stage of a frame began, and when the frame ended.
   struct StageTimes {
     Clock::time_point setup, binning, raster, post, end;
@@ -193,6 +201,7 @@ Renderer::Impl::LifeCounters Renderer::Impl::begin_frame_counters() {
 }
 
 void Renderer::Impl::set_up_triangles() {
+  nearest_first = options.mode.kind == ModeKind::Coverage && !front_end.every_instance_convex();
   std::vector<std::pair<std::size_t, std::size_t>> blocks;
   for (std::size_t i = 0; i < front_end.instance_count(); ++i) {
     for (std::size_t v = 0; v < front_end.vertex_count(i); v += kVerticesPerBlock) {
@@ -232,9 +241,7 @@ void Renderer::Impl::raster_tiles(const detail::FrameTarget& target) {
                         });
 }
 
-void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
-                                 const detail::FrameTarget& target) {
-  raster.begin_tile(grid.tile_rect(tile), target);
+void Renderer::Impl::draw_in_submission_order(detail::TileRasterizer& raster, int tile) {
   for (std::size_t c = 0; c < chunk_bins.size(); ++c) {
     const auto& tris = chunk_triangles[c];
     const std::span<const std::uint32_t> list = chunk_bins[c].tile(tile);
@@ -248,6 +255,34 @@ void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
       }
       raster.draw(tris[list[k]]);
     }
+  }
+}
+
+void Renderer::Impl::draw_nearest_first(detail::TileRasterizer& raster, int tile) {
+  thread_local std::vector<const detail::TriangleSetup*> order;
+  thread_local std::vector<std::uint64_t> keys;
+  order.clear();
+  for (std::size_t c = 0; c < chunk_bins.size(); ++c) {
+    for (const std::uint32_t i : chunk_bins[c].tile(tile)) order.push_back(&chunk_triangles[c][i]);
+  }
+  detail::sort_nearest_first(order, keys);
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    if (k + kPrefetchAhead < order.size()) {
+      const char* ahead = reinterpret_cast<const char*>(order[k + kPrefetchAhead]);
+      __builtin_prefetch(ahead);
+      __builtin_prefetch(ahead + 64);
+    }
+    raster.draw(*order[k]);
+  }
+}
+
+void Renderer::Impl::raster_tile(detail::TileRasterizer& raster, int tile,
+                                 const detail::FrameTarget& target) {
+  raster.begin_tile(grid.tile_rect(tile), target);
+  if (nearest_first) {
+    draw_nearest_first(raster, tile);
+  } else {
+    draw_in_submission_order(raster, tile);
   }
   // end_tile resolves; banded modes also rasterise there, and that part counts as raster.
   const double deferred = raster.deferred_raster_ms();
