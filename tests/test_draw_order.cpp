@@ -67,12 +67,11 @@ TEST_CASE("coverage's draw order: nearest first by the plane at the vertices, ti
   const TriangleSetup a = setup_at(0.5, 0.0, 0), b = setup_at(0.3, 0.0, 1),
                       c = setup_at(0.6, -0.05, 2), d = setup_at(0.3, 0.0, 3);
   std::vector<const TriangleSetup*> order = {&a, &b, &c, &d};
-  std::vector<std::uint64_t> keys;
-  covrast::detail::sort_nearest_first(order, keys);
+  covrast::detail::sort_nearest_first(order);
   CHECK(order == std::vector<const TriangleSetup*>{&c, &b, &d, &a});
   // The same set submitted in another order: the same order but for the tie.
   std::vector<const TriangleSetup*> again = {&d, &a, &c, &b};
-  covrast::detail::sort_nearest_first(again, keys);
+  covrast::detail::sort_nearest_first(again);
   CHECK(again == std::vector<const TriangleSetup*>{&c, &d, &b, &a});
 }
 

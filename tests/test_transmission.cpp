@@ -117,8 +117,10 @@ glm::dvec3 expected(const Transmissive& c, const SpecularAlbedo& table, const gl
 }
 
 /// The single-sided lit sphere (its far side culled) over kBackground, sun and sky.
-covrast::Scene transmissive_sphere(const glm::dvec3& base, const Transmissive& c) {
-  covrast::Scene scene = covrast::test::lit_sphere_scene(glm::vec3(base), c.material);
+/// `rings`: the sphere's tessellation (lit_sphere_scene).
+covrast::Scene transmissive_sphere(const glm::dvec3& base, const Transmissive& c, int rings = 96) {
+  covrast::Scene scene =
+      covrast::test::lit_sphere_scene(glm::vec3(base), c.material, {0.0, 0.0, 3.0}, rings);
   scene.background_linear = glm::vec3(kBackground);
   covrast::test::light_sun_and_sky(scene, -c.to_sun, kSun, kSky);
   return scene;
@@ -241,11 +243,8 @@ TEST_CASE("through a transmissive surface only the opaque scene shows: one wall 
     const auto render = [&](const Transmissive& c) {
       // A coarse sphere, and a small image for the exact reference (4096 shaded samples a
       // pixel): the property holds for any closed shell at any size.
-      covrast::Scene scene =
-          covrast::test::lit_sphere_scene(glm::vec3(base), c.material, {0.0, 0.0, 3.0}, 12);
+      covrast::Scene scene = transmissive_sphere(base, c, 12);
       if (std::string(mode) == "reference") scene.width = scene.height = 32;
-      scene.background_linear = glm::vec3(kBackground);
-      covrast::test::light_sun_and_sky(scene, -c.to_sun, kSun, kSky);
       return covrast::test::render_mode(scene, mode);
     };
     CHECK(covrast::test::max_difference(render(shell), render(single)) <= 1);

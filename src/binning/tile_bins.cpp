@@ -137,8 +137,8 @@ void sort_keys(std::vector<std::uint64_t>& keys, std::vector<std::uint64_t>& oth
 
 }  // namespace
 
-void sort_nearest_first(std::vector<const TriangleSetup*>& triangles,
-                        std::vector<std::uint64_t>& keys) {
+void sort_nearest_first(std::vector<const TriangleSetup*>& triangles) {
+  thread_local std::vector<std::uint64_t> keys;
   keys.clear();
   for (std::size_t i = 0; i < triangles.size(); ++i) {
     keys.push_back(std::uint64_t(nearest_depth_key(*triangles[i])) << 32 | std::uint64_t(i));

@@ -62,8 +62,7 @@ void bin_chunk(const TileGrid& grid, std::span<const PixelBounds16> bounds, Chun
 /// Why nearest first: the A-buffer drops what lies behind a proven layer or closed set as it
 /// arrives, and skips a triangle hidden all over its box before its area kernel runs
 /// (docs/coverage.md, section 2, "Draw order"); what arrives before its occluder is logged,
-/// masked and resolved instead. `keys` is scratch, reused between calls.
-void sort_nearest_first(std::vector<const TriangleSetup*>& triangles,
-                        std::vector<std::uint64_t>& keys);
+/// masked and resolved instead. Its scratch is the calling thread's, reused between calls.
+void sort_nearest_first(std::vector<const TriangleSetup*>& triangles);
 
 }  // namespace covrast::detail

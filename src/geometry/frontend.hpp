@@ -222,7 +222,7 @@ class GeometryFrontEnd {
   /// the sphere grid its nearest-first order cost more than it saved; binning/tile_bins.hpp,
   /// sort_nearest_first).
   bool every_instance_convex() const {
-    for (std::size_t i = 0; i < scene_.meshes.size(); ++i) {
+    for (std::size_t i = 0; i < instance_count(); ++i) {
       if (!convex_surface(i)) return false;
     }
     return true;

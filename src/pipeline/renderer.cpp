@@ -43,6 +43,14 @@ using Clock = std::chrono::steady_clock;
 /// a fetch from memory to arrive in time).
 constexpr std::size_t kPrefetchAhead = 4;
 
+/// A tile's triangles are scattered through their chunks: the tile loops fetch each set-up
+/// (two cache lines) kPrefetchAhead triangles before drawing it.
+void prefetch_setup(const detail::TriangleSetup& t) {
+  const char* bytes = reinterpret_cast<const char*>(&t);
+  __builtin_prefetch(bytes);
+  __builtin_prefetch(bytes + 64);
+}
+
 double ms_between(Clock::time_point a, Clock::time_point b) {
   return std::chrono::duration<double, std::milli>(b - a).count();
 }
@@ -246,13 +254,7 @@ void Renderer::Impl::draw_in_submission_order(detail::TileRasterizer& raster, in
     const auto& tris = chunk_triangles[c];
     const std::span<const std::uint32_t> list = chunk_bins[c].tile(tile);
     for (std::size_t k = 0; k < list.size(); ++k) {
-      // The tile's triangles are scattered through the chunk: fetch the set-up (two cache
-      // lines) a few triangles ahead.
-      if (k + kPrefetchAhead < list.size()) {
-        const char* ahead = reinterpret_cast<const char*>(&tris[list[k + kPrefetchAhead]]);
-        __builtin_prefetch(ahead);
-        __builtin_prefetch(ahead + 64);
-      }
+      if (k + kPrefetchAhead < list.size()) prefetch_setup(tris[list[k + kPrefetchAhead]]);
       raster.draw(tris[list[k]]);
     }
   }
@@ -260,18 +262,13 @@ void Renderer::Impl::draw_in_submission_order(detail::TileRasterizer& raster, in
 
 void Renderer::Impl::draw_nearest_first(detail::TileRasterizer& raster, int tile) {
   thread_local std::vector<const detail::TriangleSetup*> order;
-  thread_local std::vector<std::uint64_t> keys;
   order.clear();
   for (std::size_t c = 0; c < chunk_bins.size(); ++c) {
     for (const std::uint32_t i : chunk_bins[c].tile(tile)) order.push_back(&chunk_triangles[c][i]);
   }
-  detail::sort_nearest_first(order, keys);
+  detail::sort_nearest_first(order);
   for (std::size_t k = 0; k < order.size(); ++k) {
-    if (k + kPrefetchAhead < order.size()) {
-      const char* ahead = reinterpret_cast<const char*>(order[k + kPrefetchAhead]);
-      __builtin_prefetch(ahead);
-      __builtin_prefetch(ahead + 64);
-    }
+    if (k + kPrefetchAhead < order.size()) prefetch_setup(*order[k + kPrefetchAhead]);
     raster.draw(*order[k]);
   }
 }
