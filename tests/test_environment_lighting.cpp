@@ -19,6 +19,7 @@
 #include <initializer_list>
 #include <memory>
 #include <numbers>
+#include <thread>
 #include <vector>
 
 #include "test_sphere_scene.hpp"
@@ -422,4 +423,90 @@ TEST_CASE("environment: scenes/studio.json gives the same bytes for every thread
           .color;
   // Lit by the environment: the gold sphere's middle is far from the background.
   CHECK(int(first.pixel(80, 45)[0]) > 120);
+}
+
+TEST_CASE("environment: a prepared map is kept for the same texels and made anew when they change",
+          "[environment][cache]") {
+  using covrast::detail::environment_map_cache_counts;
+  using covrast::detail::EnvironmentLighting;
+  using covrast::detail::PreparedEnvironmentMap;
+  // A map no other test uses (the cache is process-wide), with a sun and a gradient.
+  auto map = std::make_shared<EnvironmentMap>();
+  map->width = 48;
+  map->height = 24;
+  for (int y = 0; y < map->height; ++y) {
+    for (int x = 0; x < map->width; ++x) {
+      map->radiance_linear.push_back(glm::vec3(0.25f + 0.01f * float(x), 0.5f, 0.013f * float(y)));
+    }
+  }
+  map->radiance_linear[7 * 48 + 30] = glm::vec3(900.0f, 800.0f, 700.0f);
+  const glm::dvec3 n = glm::normalize(glm::dvec3(0.3, 0.5, -0.8));
+  const glm::dvec3 v = glm::normalize(glm::dvec3(-0.2, 0.4, 0.9));
+
+  const auto before = environment_map_cache_counts();
+  const EnvironmentLighting first(EnvironmentLight{map, 0.0, 1.0});
+  CHECK(environment_map_cache_counts().preparations == before.preparations + 1);
+
+  // Another map object with the same texels, turned and brighter: the same preparation, and
+  // the same bits as one made without the cache.
+  const auto copy = std::make_shared<const EnvironmentMap>(*map);
+  const EnvironmentLighting second(EnvironmentLight{copy, 30.0, 2.0});
+  CHECK(&second.prepared() == &first.prepared());
+  CHECK(environment_map_cache_counts().hits == before.hits + 1);
+  const PreparedEnvironmentMap fresh(*copy);
+  for (const double roughness : {0.0, 0.2, 0.7, 1.0}) {
+    CHECK(second.prepared().prefiltered_radiance(n, roughness) ==
+          fresh.prefiltered_radiance(n, roughness));
+  }
+  CHECK(second.prepared().irradiance_without_suns(v) == fresh.irradiance_without_suns(v));
+  REQUIRE(first.suns().size() == 1);
+  CHECK(second.suns().size() == 1);
+
+  // The first map changed in place: prepared anew, and lit by its new texels.
+  map->radiance_linear[7 * 48 + 30] = glm::vec3(0.5f);
+  const EnvironmentLighting changed(EnvironmentLight{map, 0.0, 1.0});
+  CHECK(&changed.prepared() != &first.prepared());
+  CHECK(environment_map_cache_counts().preparations == before.preparations + 2);
+  CHECK(changed.suns().empty());
+  const PreparedEnvironmentMap fresh_changed(*map);
+  CHECK(changed.irradiance(n) == fresh_changed.irradiance_without_suns(n));
+  const glm::dvec3 towards_sun = first.suns()[0].to_light;
+  CHECK(changed.irradiance(towards_sun).x < first.irradiance(towards_sun).x - 1.0);
+}
+
+TEST_CASE("environment: lights made on several threads at once share a map's preparation",
+          "[environment][cache][threads]") {
+  using covrast::detail::environment_map_cache_counts;
+  using covrast::detail::EnvironmentLighting;
+  using covrast::detail::PreparedEnvironmentMap;
+  auto map = std::make_shared<EnvironmentMap>();
+  map->width = 40;
+  map->height = 20;
+  for (int i = 0; i < map->width * map->height; ++i) {
+    map->radiance_linear.push_back(glm::vec3(0.1f + 0.002f * float(i % 97), 0.3f, 0.7f));
+  }
+  const glm::dvec3 n = glm::normalize(glm::dvec3(-0.4, 0.7, 0.2));
+  const PreparedEnvironmentMap fresh(*map);
+  constexpr int kThreads = 4;
+  std::vector<glm::dvec3> irradiance(kThreads);
+  const auto before = environment_map_cache_counts();
+  {
+    std::vector<std::thread> threads;
+    for (int k = 0; k < kThreads; ++k) {
+      threads.emplace_back([&, k] {
+        // Each thread its own copy of the texels: equal contents, not the same object.
+        const auto copy = std::make_shared<const EnvironmentMap>(*map);
+        const EnvironmentLighting lighting(EnvironmentLight{copy, 0.0, 1.0});
+        irradiance[std::size_t(k)] = lighting.irradiance_without_suns(n);
+      });
+    }
+    for (std::thread& t : threads) t.join();
+  }
+  const auto after = environment_map_cache_counts();
+  CHECK(after.hits + after.preparations == before.hits + before.preparations + kThreads);
+  CHECK(after.preparations >= before.preparations + 1);
+  for (const glm::dvec3& e : irradiance) CHECK(e == fresh.irradiance_without_suns(n));
+  // Kept: one more light is served without preparing.
+  const EnvironmentLighting later(EnvironmentLight{map, 0.0, 1.0});
+  CHECK(environment_map_cache_counts().preparations == after.preparations);
 }

@@ -133,15 +133,9 @@ glm::dvec3 EnvironmentSky::radiance(const glm::dvec3& d_world) const {
          intensity_;
 }
 
-EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
-  const EnvironmentMap& map = *light.map;
+PreparedEnvironmentMap::PreparedEnvironmentMap(const EnvironmentMap& map) {
   const int w = map.width, h = map.height;
-  const double rotation = light.rotation_deg * (kPi / 180.0);
-  cos_rotation_ = std::cos(rotation);
-  sin_rotation_ = std::sin(rotation);
-  intensity_ = light.intensity;
   texel_solid_angle_ = 4.0 * kPi / (double(w) * double(h));
-
   // Suns: the brightest texels by power leave the map (zero in the copy the pyramids are
   // built from).
   std::vector<glm::vec3> texels = map.radiance_linear;
@@ -150,6 +144,14 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
   build_moment_pyramid();
   build_irradiance_nodes();
   build_prefiltered();
+}
+
+EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light)
+    : prepared_(prepare_environment_map(*light.map)),
+      suns_(prepared_->suns()),
+      cos_rotation_(std::cos(light.rotation_deg * (kPi / 180.0))),
+      sin_rotation_(std::sin(light.rotation_deg * (kPi / 180.0))),
+      intensity_(light.intensity) {
   // The suns in the world frame, and x intensity.
   for (EnvironmentSun& sun : suns_) {
     sun.to_light = to_world(sun.to_light);
@@ -159,7 +161,7 @@ EnvironmentLighting::EnvironmentLighting(const EnvironmentLight& light) {
 
 // Radiance pyramid: each level halves the previous (rounding up), texels averaged with their
 // solid angles as weights.
-void EnvironmentLighting::build_radiance_pyramid(std::vector<glm::vec3> texels, int w, int h) {
+void PreparedEnvironmentMap::build_radiance_pyramid(std::vector<glm::vec3> texels, int w, int h) {
   radiance_.push_back({w, h, std::move(texels)});
   while (radiance_.back().width > 1 || radiance_.back().height > 1) {
     const RadianceLevel& fine = radiance_.back();
@@ -186,8 +188,8 @@ void EnvironmentLighting::build_radiance_pyramid(std::vector<glm::vec3> texels, 
   }
 }
 
-void EnvironmentLighting::set_cell_geometry(MomentCell& cell, double u0, double u1, double v0,
-                                            double v1) {
+void PreparedEnvironmentMap::set_cell_geometry(MomentCell& cell, double u0, double u1, double v0,
+                                               double v1) {
   cell.centre = environment_direction(0.5 * (u0 + u1), 0.5 * (v0 + v1));
   // The farthest point of a latitude-longitude rectangle from its centre is a corner.
   double min_cos = 1.0;
@@ -203,7 +205,7 @@ void EnvironmentLighting::set_cell_geometry(MomentCell& cell, double u0, double 
 
 // Moment pyramid, from the radiance pyramid's level 0: the finest cells group whole texels;
 // every coarser level merges 2 x 2.
-void EnvironmentLighting::build_moment_pyramid() {
+void PreparedEnvironmentMap::build_moment_pyramid() {
   const int w = radiance_[0].width, h = radiance_[0].height;
   const int cells_x = floor_pow2(std::min(w, kMomentCellsAcross));
   const int cells_y = floor_pow2(std::min(h, kMomentCellsAcross / 2));
@@ -252,7 +254,7 @@ void EnvironmentLighting::build_moment_pyramid() {
 
 // The irradiance of the map without its suns at the nodes, by the exact walk; smooth (a
 // cosine-weighted integral of a map without bright points), so interpolated between them.
-void EnvironmentLighting::build_irradiance_nodes() {
+void PreparedEnvironmentMap::build_irradiance_nodes() {
   irradiance_nodes_.reserve(std::size_t(kIrradianceNodesAcross) * kIrradianceNodesDown);
   for (int y = 0; y < kIrradianceNodesDown; ++y) {
     for (int x = 0; x < kIrradianceNodesAcross; ++x) {
@@ -279,12 +281,15 @@ glm::dvec3 EnvironmentLighting::irradiance(const glm::dvec3& n_world) const {
 }
 
 glm::dvec3 EnvironmentLighting::irradiance_without_suns(const glm::dvec3& n_world) const {
-  return equirect_bilinear(irradiance_nodes_, kIrradianceNodesAcross, kIrradianceNodesDown,
-                           environment_uv(to_map(n_world))) *
-         intensity_;
+  return prepared_->irradiance_without_suns(to_map(n_world)) * intensity_;
 }
 
-glm::dvec3 EnvironmentLighting::walk_irradiance(const glm::dvec3& n) const {
+glm::dvec3 PreparedEnvironmentMap::irradiance_without_suns(const glm::dvec3& n_map) const {
+  return equirect_bilinear(irradiance_nodes_, kIrradianceNodesAcross, kIrradianceNodesDown,
+                           environment_uv(n_map));
+}
+
+glm::dvec3 PreparedEnvironmentMap::walk_irradiance(const glm::dvec3& n) const {
   glm::dvec3 e(0.0);
   // Depth-first over the cells the horizon cuts; (level, index) pairs.
   struct Pending {
@@ -319,11 +324,12 @@ glm::dvec3 EnvironmentLighting::walk_irradiance(const glm::dvec3& n) const {
   return e;
 }
 
-glm::dvec3 EnvironmentLighting::bilinear(const RadianceLevel& level, const glm::dvec2& uv) const {
+glm::dvec3 PreparedEnvironmentMap::bilinear(const RadianceLevel& level,
+                                            const glm::dvec2& uv) const {
   return equirect_bilinear(level.texels, level.width, level.height, uv);
 }
 
-glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) const {
+glm::dvec3 PreparedEnvironmentMap::lookup(const glm::dvec3& d_map, double lod) const {
   const double top = double(radiance_.size() - 1);
   lod = std::clamp(lod, 0.0, top);
   const int l0 = std::min(int(lod), int(radiance_.size()) - 1);
@@ -334,7 +340,7 @@ glm::dvec3 EnvironmentLighting::lookup(const glm::dvec3& d_map, double lod) cons
   return a * (1.0 - t) + bilinear(radiance_[std::size_t(l0 + 1)], uv) * t;
 }
 
-void EnvironmentLighting::build_prefiltered() {
+void PreparedEnvironmentMap::build_prefiltered() {
   const int widest = std::min(floor_pow2(radiance_[0].width), kPrefilterWidest);
   for (int node = 1; node <= kPrefilterNodes; ++node) {
     const double roughness = prefilter_node_roughness(node);
@@ -361,7 +367,7 @@ void EnvironmentLighting::build_prefiltered() {
   }
 }
 
-std::vector<EnvironmentLighting::PrefilterSample> EnvironmentLighting::prefilter_lobe(
+std::vector<PreparedEnvironmentMap::PrefilterSample> PreparedEnvironmentMap::prefilter_lobe(
     int samples, double alpha2) const {
   // n = v = r (the split-sum assumption): P(r) = sum L(l) w / sum w over GGX half vectors with
   // w = V(n.l, 1) (n.l), the weight of A's estimator at n = v (Karis, "Real Shading in Unreal
@@ -386,8 +392,8 @@ std::vector<EnvironmentLighting::PrefilterSample> EnvironmentLighting::prefilter
   return lobe;
 }
 
-glm::dvec3 EnvironmentLighting::prefilter_texel(const glm::dvec3& r,
-                                                const std::vector<PrefilterSample>& lobe) const {
+glm::dvec3 PreparedEnvironmentMap::prefilter_texel(const glm::dvec3& r,
+                                                   const std::vector<PrefilterSample>& lobe) const {
   glm::dvec3 t, b;
   tangent_frame(r, t, b);
   glm::dvec3 sum(0.0);
@@ -400,8 +406,8 @@ glm::dvec3 EnvironmentLighting::prefilter_texel(const glm::dvec3& r,
   return weight > 0.0 ? sum / weight : lookup(r, 0.0);
 }
 
-glm::dvec3 EnvironmentLighting::prefiltered_radiance(const glm::dvec3& r_map,
-                                                     double roughness) const {
+glm::dvec3 PreparedEnvironmentMap::prefiltered_radiance(const glm::dvec3& r_map,
+                                                        double roughness) const {
   // Between the map and node 1 linear in roughness; between two nodes linear in log alpha;
   // bilinear within each.
   roughness = std::clamp(roughness, 0.0, 1.0);
@@ -446,7 +452,7 @@ EnvironmentIntegrals EnvironmentLighting::integrals(const glm::dvec3& n_world,
     const glm::dvec3 mirror = to_map(mirror_normal_world);
     r = mirror * (2.0 * glm::dot(mirror, v)) - v;
   }
-  const glm::dvec3 prefiltered = prefiltered_radiance(r, roughness) * intensity_;
+  const glm::dvec3 prefiltered = prepared_->prefiltered_radiance(r, roughness) * intensity_;
   out.specular = prefiltered * uniform[1];
   out.specular_schlick = prefiltered * uniform[2];
   return out;

@@ -1,5 +1,6 @@
-// Image-based lighting (docs/environments.md): an environment map prepared once per frame so
-// that shade_point can integrate the glTF BRDF against it at every shading point.
+// Image-based lighting (docs/environments.md): an environment map prepared once (and kept for
+// later renders of the same texels) so that shade_point can integrate the glTF BRDF against it
+// at every shading point.
 //
 // Outgoing radiance from the environment at a point with unit normal n and view v:
 //   L_o = integral over the sphere of f(l, v) L(l) max(0, n . l) dl
@@ -36,6 +37,8 @@
 #include <glm/glm.hpp>
 
 #include <array>
+#include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace covrast::detail {
@@ -55,10 +58,83 @@ struct EnvironmentSun {
   glm::dvec3 irradiance;
 };
 
+/// What the lighting keeps of a map: built from its texels alone (in the map's frame, at
+/// intensity 1), so one preparation serves every light, rotation and intensity with the same
+/// texels (prepare_environment_map keeps the recent ones).
+class PreparedEnvironmentMap {
+ public:
+  /// The moment pyramid, the radiance pyramid, the irradiance nodes and the prefiltered
+  /// nodes of a non-empty map; its suns taken out.
+  explicit PreparedEnvironmentMap(const EnvironmentMap& map);
+
+  /// The suns, in the map's frame, at intensity 1.
+  const std::vector<EnvironmentSun>& suns() const { return suns_; }
+  /// E(n) without the suns for a unit normal in the map's frame, from the irradiance nodes.
+  glm::dvec3 irradiance_without_suns(const glm::dvec3& n_map) const;
+  /// The radiance prefiltered by the GGX lobe of `roughness` around map direction r_map.
+  glm::dvec3 prefiltered_radiance(const glm::dvec3& r_map, double roughness) const;
+
+ private:
+  struct MomentCell {
+    glm::dvec3 centre;            ///< unit direction of the cell's uv centre
+    double sin_radius;            ///< sin of the cell's angular radius around `centre`
+    std::array<glm::dvec3, 3> m;  ///< per channel: sum_t L_t[c] d_t Omega_t
+  };
+  struct MomentLevel {
+    int width = 0, height = 0;
+    std::vector<MomentCell> cells;
+  };
+  struct RadianceLevel {
+    int width = 0, height = 0;
+    std::vector<glm::vec3> texels;
+  };
+
+  /// E(n) of the map without suns for a unit normal in the map's frame, by the pyramid walk.
+  glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;
+  glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
+  glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec2& uv) const;
+  /// One GGX direction of the prefiltering lobe, in the frame of the mirror direction (+Z).
+  struct PrefilterSample {
+    glm::dvec3 l_local;
+    double weight;  ///< V(n.l, 1) (n.l)
+    double lod;     ///< pyramid level of its share of the sphere
+  };
+  void build_radiance_pyramid(std::vector<glm::vec3> texels, int width, int height);
+  static void set_cell_geometry(MomentCell& cell, double u0, double u1, double v0, double v1);
+  void build_moment_pyramid();
+  void build_irradiance_nodes();
+  void build_prefiltered();
+  std::vector<PrefilterSample> prefilter_lobe(int samples, double alpha2) const;
+  glm::dvec3 prefilter_texel(const glm::dvec3& r, const std::vector<PrefilterSample>& lobe) const;
+
+  std::vector<EnvironmentSun> suns_;  ///< map frame, intensity 1
+  std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
+  std::vector<RadianceLevel> radiance_;
+  std::vector<RadianceLevel> prefiltered_;    ///< nodes 1..kPrefilterNodes (node 0: radiance_[0])
+  std::vector<glm::dvec3> irradiance_nodes_;  ///< walk_irradiance at the node normals
+  double texel_solid_angle_ = 0.0;            ///< 4 pi / (W H) of level 0
+};
+
+/// The preparation of `map` (non-empty). A process-wide cache keeps the most recently used
+/// preparations with a copy of the texels each was built from; a map whose size and texel
+/// bits equal a kept copy gets that preparation (the same object, so the same bits as a new
+/// one), anything else, a map changed in place included, is prepared anew
+/// (environment_map_cache.cpp). Safe to call from several threads.
+std::shared_ptr<const PreparedEnvironmentMap> prepare_environment_map(const EnvironmentMap& map);
+
+/// The cache's counts since the process started (the tests read them).
+struct EnvironmentMapCacheCounts {
+  std::uint64_t hits = 0;
+  std::uint64_t preparations = 0;
+};
+EnvironmentMapCacheCounts environment_map_cache_counts();
+
+/// An environment light ready for shading: the prepared map, turned and scaled as the light
+/// says.
 class EnvironmentLighting {
  public:
-  /// Prepares `light` (its map must be non-empty): the moment pyramid and the radiance
-  /// pyramid, in the map's frame; intensity and rotation are applied at evaluation.
+  /// Prepares `light` (its map must be non-empty) through prepare_environment_map; intensity
+  /// and rotation are applied at evaluation.
   explicit EnvironmentLighting(const EnvironmentLight& light);
 
   /// E(n) = int L(l) max(0, n . l) dl for a unit world-space normal.
@@ -80,50 +156,15 @@ class EnvironmentLighting {
   /// The texels taken out of the map as directional lights (integrals() leaves them out;
   /// irradiance() includes them): each holds at least kSunPowerShare of the map's power.
   const std::vector<EnvironmentSun>& suns() const { return suns_; }
+  /// The preparation this light reads (shared with other lights of the same texels).
+  const PreparedEnvironmentMap& prepared() const { return *prepared_; }
 
  private:
-  struct MomentCell {
-    glm::dvec3 centre;            ///< unit direction of the cell's uv centre
-    double sin_radius;            ///< sin of the cell's angular radius around `centre`
-    std::array<glm::dvec3, 3> m;  ///< per channel: sum_t L_t[c] d_t Omega_t
-  };
-  struct MomentLevel {
-    int width = 0, height = 0;
-    std::vector<MomentCell> cells;
-  };
-  struct RadianceLevel {
-    int width = 0, height = 0;
-    std::vector<glm::vec3> texels;
-  };
-
   glm::dvec3 to_map(const glm::dvec3& d) const;
   glm::dvec3 to_world(const glm::dvec3& d) const;
-  /// E(n) of the map without suns for a unit normal in the map's frame, by the pyramid walk.
-  glm::dvec3 walk_irradiance(const glm::dvec3& n_map) const;
-  glm::dvec3 lookup(const glm::dvec3& d_map, double lod) const;
-  glm::dvec3 bilinear(const RadianceLevel& level, const glm::dvec2& uv) const;
-  /// One GGX direction of the prefiltering lobe, in the frame of the mirror direction (+Z).
-  struct PrefilterSample {
-    glm::dvec3 l_local;
-    double weight;  ///< V(n.l, 1) (n.l)
-    double lod;     ///< pyramid level of its share of the sphere
-  };
-  void build_radiance_pyramid(std::vector<glm::vec3> texels, int width, int height);
-  static void set_cell_geometry(MomentCell& cell, double u0, double u1, double v0, double v1);
-  void build_moment_pyramid();
-  void build_irradiance_nodes();
-  void build_prefiltered();
-  std::vector<PrefilterSample> prefilter_lobe(int samples, double alpha2) const;
-  glm::dvec3 prefilter_texel(const glm::dvec3& r, const std::vector<PrefilterSample>& lobe) const;
-  /// The radiance prefiltered by the GGX lobe of `roughness` around map direction r_map.
-  glm::dvec3 prefiltered_radiance(const glm::dvec3& r_map, double roughness) const;
 
-  std::vector<EnvironmentSun> suns_;
-  std::vector<MomentLevel> moments_;  ///< [0] the finest cells, back() the roots
-  std::vector<RadianceLevel> radiance_;
-  std::vector<RadianceLevel> prefiltered_;    ///< nodes 1..kPrefilterNodes (node 0: radiance_[0])
-  std::vector<glm::dvec3> irradiance_nodes_;  ///< walk_irradiance at the node normals
-  double texel_solid_angle_ = 0.0;            ///< 4 pi / (W H) of level 0
+  std::shared_ptr<const PreparedEnvironmentMap> prepared_;
+  std::vector<EnvironmentSun> suns_;  ///< world frame, x intensity
   double cos_rotation_ = 1.0, sin_rotation_ = 0.0;
   double intensity_ = 1.0;
 };
