@@ -1357,6 +1357,46 @@ TEST_CASE("textures: coverage mode's texture is the exact mean over the pixel", 
   }
 }
 
+TEST_CASE("textures: a partly hidden textured fragment shows the texture of its shown side",
+          "[textures]") {
+  // A 15x15 quad textured with two NEAREST texels, white left, black right: their edge runs
+  // down the middle of pixel column 7. A red triangle nearer the eye hides the quad's right
+  // half, its edge on the same line. In column 7 the reference sees the quad's white half
+  // and the red half: (1, 1/2, 1/2) in linear light. The quad's mean over the whole pixel
+  // is grey: weighed by its shown share it would give (3/4, 1/4, 1/4), 51 codes off in green.
+  // The masked resolve moves the partly hidden fragment's colour towards its shown side
+  // (raster/coverage/fragment_shading.hpp, shade_fragment_visible).
+  const int size = 15;
+  const std::vector<std::uint8_t> white_black = {255, 255, 255, 255, 0, 0, 0, 255};
+  covrast::Scene scene =
+      quad_scene(size, slot_of(covrast::make_texture("halves", 2, 1, white_black, true),
+                               covrast::TextureFilter::Nearest, covrast::TextureFilter::Nearest,
+                               covrast::MipFilter::None));
+  covrast::MeshArrays cover{.name = "cover",
+                            .positions = {{0, -2, 0.25f}, {2, 0, 0.25f}, {0, 2, 0.25f}},
+                            .indices = {0, 1, 2}};
+  covrast::add_instance(scene, covrast::make_mesh(cover), {.color_srgb = glm::vec3(1, 0, 0)});
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode("coverage");
+  const covrast::RenderResult result = covrast::render(scene, options);
+  CHECK(result.stats.resolve_paths.masked >= std::uint64_t(size));  // column 7 at least
+  const int half = int(std::lround(srgb_encode_255(0.5)));
+  const int expected[3] = {255, half, half};
+  int largest = 0;
+  for (int py = 0; py < size; ++py) {
+    for (int c = 0; c < 3; ++c) {
+      const int want = expected[c];
+      const int code = result.color.rgb[(std::size_t(py) * size + 7) * 3 + c];
+      largest = std::max(largest, std::abs(code - want));
+    }
+  }
+  INFO("largest difference in column 7 from (1, 1/2, 1/2): " << largest);
+  CHECK(largest <= 2);
+  // Left of it the quad's white, right of it the red triangle, exactly.
+  CHECK(result.color.rgb[(7 * size + 6) * 3 + 1] == 255);
+  CHECK(result.color.rgb[(7 * size + 8) * 3 + 1] == 0);
+}
+
 TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa:4's points",
           "[textures]") {
   // 512x512 texels on 48x48 pixels, level 0 only: a pixel spans about 11 x 11 texels, more

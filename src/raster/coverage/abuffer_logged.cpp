@@ -123,6 +123,18 @@ struct MaskedPixel {
     });
   }
 
+  /// Whether fragment i is textured, a nearer fragment hides some but not all of its
+  /// samples, and those stand for at least kVisibleShadingMinShare of the pixel once its
+  /// weight is scaled by `scale`: then shade_fragment_visible gives its colour.
+  bool shows_partly(int i, double scale) const {
+    if (i >= shown || tri[i]->shading == nullptr || !tri[i]->shading->surface->has_texture_slots) {
+      return false;
+    }
+    const int own = mask[i].count(), keeps = kept[i].count();
+    return keeps > 0 && keeps < own &&
+           weight[i] * scale * double(own - keeps) / own >= kVisibleShadingMinShare;
+  }
+
   /// The weights, as the list's sample resolve gives them: the exact area where a fragment
   /// keeps all its samples; else its area times the share it keeps, those estimates scaled
   /// together to fill what the exact areas and the background's samples leave, each at most
@@ -262,7 +274,10 @@ void ABufferTile::resolve_masked(std::size_t pixel, int x, int y, glm::vec3 back
                   "a fragment's visible weight lies between 0 and its exact area");
     depth = std::min(depth, float(p.centre_z[i]));
     if (p.weight[i] == 0.0) continue;
-    rgb += p.weight[i] * scale * glm::dvec3(shade_fragment(*p.tri[i], x, y));
+    const glm::vec3 color = p.shows_partly(i, scale)
+                                ? shade_fragment_visible(*p.tri[i], x, y, p.mask[i], p.kept[i])
+                                : shade_fragment(*p.tri[i], x, y);
+    rgb += p.weight[i] * scale * glm::dvec3(color);
   }
   color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(background));
   depth_[pixel] = depth;

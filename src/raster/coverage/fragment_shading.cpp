@@ -1,6 +1,7 @@
 // Coverage mode's shading of a fragment of a textured surface (fragment_shading.hpp).
 #include "raster/coverage/fragment_shading.hpp"
 
+#include "core/checks.hpp"
 #include "core/convex_polygon.hpp"
 
 #include <algorithm>
@@ -65,6 +66,25 @@ AlphaRange surface_alpha_range(const TriangleSetup& t, const double mu[3],
     }
   }
   return range;
+}
+
+/// The mean of the point shadings at up to kVisibleShadingPoints of the `count` samples of
+/// `set`, the ones at positions (j + 1/2) count / picks in its sample order.
+glm::dvec3 sampled_shading(const TriangleSetup& t, int x, int y, const SampleMask& set, int count) {
+  const int picks = std::min(count, kVisibleShadingPoints);
+  glm::dvec3 sum(0.0);
+  int index = 0, picked = 0;
+  int next = count / (2 * picks);  // (0 + 1/2) count / picks, rounded down
+  for_each_sample(set, [&](int k) {
+    if (picked < picks && index == next) {
+      sum += glm::dvec3(
+          shade(t, x + kSampleOffsetX[std::size_t(k)], y + kSampleOffsetY[std::size_t(k)], true));
+      ++picked;
+      next = (2 * picked + 1) * count / (2 * picks);
+    }
+    ++index;
+  });
+  return sum / double(picks);
 }
 
 }  // namespace
@@ -154,6 +174,21 @@ ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
   double mu[3];
   perspective_weights(t, x + 0.5, y + 0.5, true, mu);
   return {rgb, surface_alpha(t, mu[0], mu[1], mu[2])};
+}
+
+glm::vec3 shade_fragment_visible(const TriangleSetup& t, int x, int y, const SampleMask& own,
+                                 const SampleMask& kept) {
+  const int own_count = own.count(), kept_count = kept.count();
+  COVRAST_CHECK(kept_count > 0 && kept_count < own_count && (kept & own) == kept,
+                "a partly shown fragment keeps some, not all, of its own samples");
+  SampleMask lost = own;
+  for (int w = 0; w < 4; ++w) lost.word[w] &= ~kept.word[w];
+  const glm::dvec3 shown_side = sampled_shading(t, x, y, kept, kept_count);
+  const glm::dvec3 hidden_side = sampled_shading(t, x, y, lost, own_count - kept_count);
+  const double hidden_share = double(own_count - kept_count) / own_count;
+  const glm::dvec3 visible =
+      glm::dvec3(shade_fragment(t, x, y)) + hidden_share * (shown_side - hidden_side);
+  return glm::vec3(glm::max(visible, glm::dvec3(0.0)));
 }
 
 glm::vec3 shade_fragment_averaged(const TriangleSetup& t, int x, int y) {

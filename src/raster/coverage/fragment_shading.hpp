@@ -13,6 +13,7 @@
 // 256-sample supersampling was 29/255 and 10/255 off at worst.
 #pragma once
 
+#include "raster/coverage/sample_mask.hpp"
 #include "shading/shading.hpp"
 #include "shading/shading_inputs.hpp"
 
@@ -58,6 +59,28 @@ MaskShare mask_share(const TriangleSetup& t, int x, int y);
 /// alpha, and the shading at its centroid with its mean base colour texel; else opaque. A
 /// transmissive surface's fragment (a BLEND layer) carries its filter too.
 ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y);
+
+/// Kept and lost samples at which shade_fragment_visible shades, at most, each.
+inline constexpr int kVisibleShadingPoints = 4;
+/// The least share of the pixel [pixels] a textured fragment's hidden samples must stand for
+/// (its weight in the pixel times lost / own) for the resolve to move its colour towards what
+/// shows: below it the move is under 1% of the difference between the two sides.
+inline constexpr double kVisibleShadingMinShare = 0.01;
+
+/// The colour of a textured fragment of which a nearer one hides some samples: shade_fragment
+/// over its whole part, moved towards its shown side. With W the mean over the part and V, H
+/// the means over the shown and the hidden side, in proportions k and h of its samples (k + h
+/// = 1), W = k V + h H, so
+///   V = W + h (V - H),
+/// and V - H is estimated from the point shadings (as the reference shades its samples) at up
+/// to kVisibleShadingPoints of the `kept` samples and as many of the lost ones (`own` without
+/// `kept`), evenly spaced in sample order; clamped at 0. Exact where the shading is constant
+/// on each side; W, not a mean of points, carries the texture's exact average. Without it a
+/// partly hidden fragment shows the texture of its hidden side too: the helmet's visor rim
+/// over a dark band, the Duck's eye ring (docs/coverage.md, section 3).
+/// Requires 0 < count(kept) < count(own), kept within own.
+glm::vec3 shade_fragment_visible(const TriangleSetup& t, int x, int y, const SampleMask& own,
+                                 const SampleMask& kept);
 
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
 inline glm::vec3 shade_fragment(const TriangleSetup& t, int x, int y) {
