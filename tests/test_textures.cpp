@@ -1357,44 +1357,84 @@ TEST_CASE("textures: coverage mode's texture is the exact mean over the pixel", 
   }
 }
 
-TEST_CASE("textures: a partly hidden textured fragment shows the texture of its shown side",
-          "[textures]") {
-  // A 15x15 quad textured with two NEAREST texels, white left, black right: their edge runs
-  // down the middle of pixel column 7. A red triangle nearer the eye hides the quad's right
-  // half, its edge on the same line. In column 7 the reference sees the quad's white half
-  // and the red half: (1, 1/2, 1/2) in linear light. The quad's mean over the whole pixel
-  // is grey: weighed by its shown share it would give (3/4, 1/4, 1/4), 51 codes off in green.
-  // The masked resolve moves the partly hidden fragment's colour towards its shown side
-  // (raster/coverage/fragment_shading.hpp, shade_fragment_visible).
-  const int size = 15;
+namespace {
+
+/// A 15x15 quad_scene textured with two NEAREST texels, white left, black right: their edge
+/// runs down the middle of pixel column 7; plus `red`, drawn red.
+constexpr int kHalvesSize = 15;
+covrast::Scene halves_scene_with(const covrast::MeshArrays& red) {
   const std::vector<std::uint8_t> white_black = {255, 255, 255, 255, 0, 0, 0, 255};
   covrast::Scene scene =
-      quad_scene(size, slot_of(covrast::make_texture("halves", 2, 1, white_black, true),
-                               covrast::TextureFilter::Nearest, covrast::TextureFilter::Nearest,
-                               covrast::MipFilter::None));
-  covrast::MeshArrays cover{.name = "cover",
-                            .positions = {{0, -2, 0.25f}, {2, 0, 0.25f}, {0, 2, 0.25f}},
-                            .indices = {0, 1, 2}};
-  covrast::add_instance(scene, covrast::make_mesh(cover), {.color_srgb = glm::vec3(1, 0, 0)});
-  covrast::RenderOptions options;
-  options.mode = covrast::parse_render_mode("coverage");
-  const covrast::RenderResult result = covrast::render(scene, options);
-  CHECK(result.stats.resolve_paths.masked >= std::uint64_t(size));  // column 7 at least
+      quad_scene(kHalvesSize, slot_of(covrast::make_texture("halves", 2, 1, white_black, true),
+                                      covrast::TextureFilter::Nearest,
+                                      covrast::TextureFilter::Nearest, covrast::MipFilter::None));
+  covrast::add_instance(scene, covrast::make_mesh(red), {.color_srgb = glm::vec3(1, 0, 0)});
+  return scene;
+}
+
+/// The largest channel difference in column 7 (rows `skip_from`..`skip_to` left out) from
+/// (1, 1/2, 1/2) in linear light: the quad's white half beside the red half.
+int column_7_difference(const covrast::Image& image, int skip_from, int skip_to) {
   const int half = int(std::lround(srgb_encode_255(0.5)));
   const int expected[3] = {255, half, half};
   int largest = 0;
-  for (int py = 0; py < size; ++py) {
+  for (int py = 0; py < kHalvesSize; ++py) {
+    if (py >= skip_from && py <= skip_to) continue;
     for (int c = 0; c < 3; ++c) {
-      const int want = expected[c];
-      const int code = result.color.rgb[(std::size_t(py) * size + 7) * 3 + c];
-      largest = std::max(largest, std::abs(code - want));
+      const int code = image.rgb[(std::size_t(py) * kHalvesSize + 7) * 3 + c];
+      largest = std::max(largest, std::abs(code - expected[c]));
     }
   }
+  return largest;
+}
+
+covrast::RenderResult render_coverage_with_stats(const covrast::Scene& scene) {
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode("coverage");
+  return covrast::render(scene, options);
+}
+
+}  // namespace
+
+TEST_CASE("textures: a partly hidden textured fragment shows the texture of its shown side",
+          "[textures]") {
+  // The white|black quad (halves_scene_with) and a red triangle nearer the eye that hides its
+  // right half, its edge on the same line. In column 7 the reference sees the quad's white
+  // half and the red half: (1, 1/2, 1/2) in linear light. The quad's mean over the whole
+  // pixel is grey: weighed by its shown share it would give (3/4, 1/4, 1/4), 51 codes off in
+  // green. The masked resolve moves the partly hidden fragment's colour towards its shown
+  // side (raster/coverage/fragment_shading.hpp, shade_fragment_visible).
+  const covrast::RenderResult result = render_coverage_with_stats(
+      halves_scene_with({.name = "cover",
+                         .positions = {{0, -2, 0.25f}, {2, 0, 0.25f}, {0, 2, 0.25f}},
+                         .indices = {0, 1, 2}}));
+  CHECK(result.stats.resolve_paths.masked >= std::uint64_t(kHalvesSize));  // column 7 at least
+  const int largest = column_7_difference(result.color, -1, -1);
   INFO("largest difference in column 7 from (1, 1/2, 1/2): " << largest);
   CHECK(largest <= 2);
   // Left of it the quad's white, right of it the red triangle, exactly.
-  CHECK(result.color.rgb[(7 * size + 6) * 3 + 1] == 255);
-  CHECK(result.color.rgb[(7 * size + 8) * 3 + 1] == 0);
+  CHECK(result.color.rgb[(7 * kHalvesSize + 6) * 3 + 1] == 255);
+  CHECK(result.color.rgb[(7 * kHalvesSize + 8) * 3 + 1] == 0);
+}
+
+TEST_CASE("textures: where a plane crosses a textured surface in a pixel, each shows its side",
+          "[textures]") {
+  // The white|black quad and a red plane z = x / 4 that crosses it along the line of column
+  // 7's middle: in front of it on the right, behind it on the left. Column 7 resolves by the
+  // list's clipped path (one triangle whose plane crosses the opaque one in the pixel); the
+  // reference sees white on the left half and red on the right: (1, 1/2, 1/2).
+  const covrast::RenderResult result = render_coverage_with_stats(halves_scene_with(
+      {.name = "plane",
+       .positions =
+           {{-1.5f, -3, -0.375f}, {1.5f, -3, 0.375f}, {1.5f, 3, 0.375f}, {-1.5f, 3, -0.375f}},
+       .indices = {0, 1, 2, 0, 2, 3}}));
+  // Column 7 but rows 6-8, where the plane's own diagonal crosses it.
+  CHECK(result.stats.resolve_paths.clipped >= std::uint64_t(kHalvesSize - 3));
+  const int largest = column_7_difference(result.color, 6, 8);
+  INFO("largest difference in column 7 from (1, 1/2, 1/2): " << largest);
+  CHECK(largest <= 2);
+  CHECK(result.color.rgb[(2 * kHalvesSize + 6) * 3 + 1] == 255);  // the quad's white
+  CHECK(result.color.rgb[(2 * kHalvesSize + 8) * 3 + 1] == 0);    // the red plane
 }
 
 TEST_CASE("textures: a NEAREST footprint over too many texels falls back to ssaa:4's points",

@@ -348,6 +348,11 @@ class ABufferTile {
   static bool front_layer_alone(const ListFragments& l, bool* in_front);
   static glm::vec3 list_weighted_color(const ListFragments& l, const double* weight,
                                        glm::vec3 behind, const Transmittance* tr, int x, int y);
+  /// The clipped path's colours: one triangle crossing the opaque plane in the pixel, with
+  /// visible weight `weight`; each textured side shows what shows of it
+  /// (shade_fragment_visible), in l and in `behind`.
+  static void show_crossing_sides(ListFragments& l, const TriangleSetup& opaque, int x, int y,
+                                  double weight, const Transmittance* tr, glm::vec3& behind);
   /// A pixel with transparent fragments: the opaque resolve seen through them plus their own
   /// weighted colours (abuffer_transparency.cpp).
   glm::vec3 resolve_transparent(std::size_t pixel, int x, int y, glm::vec3 background,

@@ -166,7 +166,11 @@ struct ABufferTile::ListFragments {
   const MergedPiece* merged[kMaxFragmentsPerPixel];  ///< null unless it stands for several
   FragmentPieces pieces[kMaxFragmentsPerPixel];
 
+  int shown_side = -1;               ///< a fragment whose colour is `shown_side_color`
+  glm::vec3 shown_side_color{0.0f};  ///< what shows of it (shade_fragment_visible)
+
   glm::vec3 color(int i, int x, int y) const {
+    if (i == shown_side) return shown_side_color;
     return merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
   }
 };
@@ -300,6 +304,7 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
   if (share >= 0.0) {
     took(&CoverageResolvePaths::clipped);
     weight[0] = double(l.cov[0]) / kCoverageOne * share;
+    show_crossing_sides(l, *opaque, x, y, weight[0], tr, behind);
   } else {
     took(&CoverageResolvePaths::samples);
     bool estimated[kMaxFragmentsPerPixel];
@@ -308,6 +313,40 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     fill_estimated_share(l.n, l.cov, estimated, double(behind_samples) / kMaskSamples, weight);
   }
   return list_weighted_color(l, weight, behind, tr, x, y);
+}
+
+void ABufferTile::show_crossing_sides(ListFragments& l, const TriangleSetup& opaque, int x, int y,
+                                      double weight, const Transmittance* tr, glm::vec3& behind) {
+  // The clipped path weighs the crossing triangle t by its exact visible share, and each
+  // surface hides a side of the other: at the samples t owns, the nearer plane (level: the
+  // earlier primitive, as everywhere) shows. A textured side is moved towards what shows of
+  // it (shade_fragment_visible), the weights stay exact.
+  const TriangleSetup& t = *l.tri[0];
+  const bool t_textured = t.shading != nullptr && t.shading->surface->has_texture_slots;
+  const bool o_textured = opaque.shading != nullptr && opaque.shading->surface->has_texture_slots;
+  if (!t_textured && !o_textured) return;
+  const SampleMask own = pixel_sample_mask(t, x, y);
+  SampleMask t_shows = SampleMask::none();
+  const SamplePlane t_plane(t, x, y), o_plane(opaque, x, y);
+  const bool t_first = t.primitive < opaque.primitive;
+  for_each_sample(own, [&](int k) {
+    const double zt = t_plane.at(k), zo = o_plane.at(k);
+    if (zt < zo || (zt == zo && t_first)) t_shows.word[k >> 6] |= 1ull << (k & 63);
+  });
+  const int own_count = own.count(), shows_count = t_shows.count();
+  if (shows_count == 0) return;
+  if (t_textured && shows_count < own_count &&
+      weight * double(own_count - shows_count) / own_count >= kVisibleShadingMinShare) {
+    l.shown_side = 0;
+    l.shown_side_color = shade_fragment_visible(t, x, y, own, t_shows);
+  }
+  if (o_textured && shows_count < kMaskSamples &&
+      double(shows_count) / kMaskSamples >= kVisibleShadingMinShare) {
+    SampleMask o_shows = SampleMask::all();
+    for (int w = 0; w < 4; ++w) o_shows.word[w] &= ~t_shows.word[w];
+    behind = shade_fragment_visible(opaque, x, y, SampleMask::all(), o_shows);
+    if (tr != nullptr) behind *= glm::vec3(tr->of(&opaque));
+  }
 }
 
 void ABufferTile::resolve_opaque_block(const TriangleSetup* opaque, const PixelRect& r,
