@@ -244,7 +244,7 @@ TEST_CASE("through a transmissive surface only the opaque scene shows: one wall 
       // A coarse sphere, and a small image for the exact reference (4096 shaded samples a
       // pixel): the property holds for any closed shell at any size.
       covrast::Scene scene = transmissive_sphere(base, c, 12);
-      if (std::string(mode) == "reference") scene.width = scene.height = 32;
+      if (std::string(mode) == "reference") scene.width = scene.height = 16;
       return covrast::test::render_mode(scene, mode);
     };
     CHECK(covrast::test::max_difference(render(shell), render(single)) <= 1);
