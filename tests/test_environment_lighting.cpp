@@ -425,20 +425,32 @@ TEST_CASE("environment: scenes/studio.json gives the same bytes for every thread
   CHECK(int(first.pixel(80, 45)[0]) > 120);
 }
 
+namespace {
+
+using covrast::detail::environment_map_cache_counts;
+using covrast::detail::EnvironmentLighting;
+using covrast::detail::PreparedEnvironmentMap;
+
+/// A W x H map whose texel (x, y) is texel(x, y), changeable in place (the cache's tests).
+template <class Texel>
+std::shared_ptr<EnvironmentMap> map_of_texels(int width, int height, const Texel& texel) {
+  auto map = std::make_shared<EnvironmentMap>();
+  map->width = width;
+  map->height = height;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) map->radiance_linear.push_back(texel(x, y));
+  }
+  return map;
+}
+
+}  // namespace
+
 TEST_CASE("environment: a prepared map is kept for the same texels and made anew when they change",
           "[environment][cache]") {
-  using covrast::detail::environment_map_cache_counts;
-  using covrast::detail::EnvironmentLighting;
-  using covrast::detail::PreparedEnvironmentMap;
   // A map no other test uses (the cache is process-wide), with a sun and a gradient.
-  auto map = std::make_shared<EnvironmentMap>();
-  map->width = 48;
-  map->height = 24;
-  for (int y = 0; y < map->height; ++y) {
-    for (int x = 0; x < map->width; ++x) {
-      map->radiance_linear.push_back(glm::vec3(0.25f + 0.01f * float(x), 0.5f, 0.013f * float(y)));
-    }
-  }
+  const auto map = map_of_texels(48, 24, [](int x, int y) {
+    return glm::vec3(0.25f + 0.01f * float(x), 0.5f, 0.013f * float(y));
+  });
   map->radiance_linear[7 * 48 + 30] = glm::vec3(900.0f, 800.0f, 700.0f);
   const glm::dvec3 n = glm::normalize(glm::dvec3(0.3, 0.5, -0.8));
   const glm::dvec3 v = glm::normalize(glm::dvec3(-0.2, 0.4, 0.9));
@@ -476,15 +488,9 @@ TEST_CASE("environment: a prepared map is kept for the same texels and made anew
 
 TEST_CASE("environment: lights made on several threads at once share a map's preparation",
           "[environment][cache][threads]") {
-  using covrast::detail::environment_map_cache_counts;
-  using covrast::detail::EnvironmentLighting;
-  using covrast::detail::PreparedEnvironmentMap;
-  auto map = std::make_shared<EnvironmentMap>();
-  map->width = 40;
-  map->height = 20;
-  for (int i = 0; i < map->width * map->height; ++i) {
-    map->radiance_linear.push_back(glm::vec3(0.1f + 0.002f * float(i % 97), 0.3f, 0.7f));
-  }
+  const auto map = map_of_texels(40, 20, [](int x, int y) {
+    return glm::vec3(0.1f + 0.002f * float((y * 40 + x) % 97), 0.3f, 0.7f);
+  });
   const glm::dvec3 n = glm::normalize(glm::dvec3(-0.4, 0.7, 0.2));
   const PreparedEnvironmentMap fresh(*map);
   constexpr int kThreads = 4;

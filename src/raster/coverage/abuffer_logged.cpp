@@ -47,6 +47,7 @@ struct MaskedPixel {
   int considered = 0;        ///< fragments with a weight: the shown ones and the nearest hidden one
   double weight[kCapacity];  ///< [pixels]
   bool estimated[kCapacity];
+  int own_count[kCapacity], kept_count[kCapacity];  ///< of mask and kept, for the shown ones
 
   void add(const TriangleSetup& t, std::uint32_t c, double z, double reach) {
     tri[n] = &t;
@@ -98,7 +99,7 @@ struct MaskedPixel {
         if (!any(shared)) continue;
         lost_any = true;
         if (far[j] <= near[i]) {
-          for (int w = 0; w < 4; ++w) free.word[w] &= ~shared.word[w];
+          free = free.without(shared);
         } else {
           split_shared(x, y, i, j, shared, free);
         }
@@ -123,16 +124,10 @@ struct MaskedPixel {
     });
   }
 
-  /// Whether fragment i is textured, a nearer fragment hides some but not all of its
-  /// samples, and those stand for at least kVisibleShadingMinShare of the pixel once its
-  /// weight is scaled by `scale`: then shade_fragment_visible gives its colour.
+  /// Whether a shown fragment i takes shade_fragment_visible's colour (shows_side), at its
+  /// weight scaled by `scale`.
   bool shows_partly(int i, double scale) const {
-    if (i >= shown || tri[i]->shading == nullptr || !tri[i]->shading->surface->has_texture_slots) {
-      return false;
-    }
-    const int own = mask[i].count(), keeps = kept[i].count();
-    return keeps > 0 && keeps < own &&
-           weight[i] * scale * double(own - keeps) / own >= kVisibleShadingMinShare;
+    return i < shown && shows_side(*tri[i], weight[i] * scale, own_count[i], kept_count[i]);
   }
 
   /// The weights, as the list's sample resolve gives them: the exact area where a fragment
@@ -144,7 +139,9 @@ struct MaskedPixel {
     const NotMerged* const no_merged[kCapacity] = {};  // a log holds no merges
     double exact = 0.0, estimate = 0.0;
     for (int i = 0; i < shown; ++i) {
-      const int own = mask[i].count(), keeps = kept[i].count();
+      own_count[i] = mask[i].count();
+      kept_count[i] = kept[i].count();
+      const int own = own_count[i], keeps = kept_count[i];
       estimated[i] = own != 0 && keeps != own;
       if (own == 0) {
         double px, py;

@@ -322,9 +322,7 @@ void ABufferTile::show_crossing_sides(ListFragments& l, const TriangleSetup& opa
   // earlier primitive, as everywhere) shows. A textured side is moved towards what shows of
   // it (shade_fragment_visible), the weights stay exact.
   const TriangleSetup& t = *l.tri[0];
-  const bool t_textured = t.shading != nullptr && t.shading->surface->has_texture_slots;
-  const bool o_textured = opaque.shading != nullptr && opaque.shading->surface->has_texture_slots;
-  if (!t_textured && !o_textured) return;
+  if (!textured(t) && !textured(opaque)) return;
   const SampleMask own = pixel_sample_mask(t, x, y);
   SampleMask t_shows = SampleMask::none();
   const SamplePlane t_plane(t, x, y), o_plane(opaque, x, y);
@@ -335,16 +333,14 @@ void ABufferTile::show_crossing_sides(ListFragments& l, const TriangleSetup& opa
   });
   const int own_count = own.count(), shows_count = t_shows.count();
   if (shows_count == 0) return;
-  if (t_textured && shows_count < own_count &&
-      weight * double(own_count - shows_count) / own_count >= kVisibleShadingMinShare) {
+  if (shows_side(t, weight, own_count, shows_count)) {
     l.shown_side = 0;
     l.shown_side_color = shade_fragment_visible(t, x, y, own, t_shows);
   }
-  if (o_textured && shows_count < kMaskSamples &&
-      double(shows_count) / kMaskSamples >= kVisibleShadingMinShare) {
-    SampleMask o_shows = SampleMask::all();
-    for (int w = 0; w < 4; ++w) o_shows.word[w] &= ~t_shows.word[w];
-    behind = shade_fragment_visible(opaque, x, y, SampleMask::all(), o_shows);
+  // The opaque surface covers the pixel (weight 1) and loses the samples where t shows.
+  if (shows_side(opaque, 1.0, kMaskSamples, kMaskSamples - shows_count)) {
+    behind =
+        shade_fragment_visible(opaque, x, y, SampleMask::all(), SampleMask::all().without(t_shows));
     if (tr != nullptr) behind *= glm::vec3(tr->of(&opaque));
   }
 }

@@ -160,7 +160,7 @@ ShadedColor shade_fragment_rgba(const TriangleSetup& t, int x, int y) {
     double mu[3];
     perspective_weights(t, x + 0.5, y + 0.5, true, mu);
     ShadedColor out{glm::vec3(0.0f), surface_alpha(t, mu[0], mu[1], mu[2])};
-    if (t.shading->surface->has_texture_slots) {
+    if (textured(t)) {
       const FragmentFootprint footprint = footprint_of(t, x, y);
       out.rgb = shade_lit(t, mu[0], mu[1], mu[2], &footprint, &out.filter);
     } else {
@@ -181,8 +181,7 @@ glm::vec3 shade_fragment_visible(const TriangleSetup& t, int x, int y, const Sam
   const int own_count = own.count(), kept_count = kept.count();
   COVRAST_CHECK(kept_count > 0 && kept_count < own_count && (kept & own) == kept,
                 "a partly shown fragment keeps some, not all, of its own samples");
-  SampleMask lost = own;
-  for (int w = 0; w < 4; ++w) lost.word[w] &= ~kept.word[w];
+  const SampleMask lost = own.without(kept);
   const glm::dvec3 shown_side = sampled_shading(t, x, y, kept, kept_count);
   const glm::dvec3 hidden_side = sampled_shading(t, x, y, lost, own_count - kept_count);
   const double hidden_share = double(own_count - kept_count) / own_count;

@@ -67,6 +67,19 @@ inline constexpr int kVisibleShadingPoints = 4;
 /// shows: below it the move is under 1% of the difference between the two sides.
 inline constexpr double kVisibleShadingMinShare = 0.01;
 
+/// Whether `t` has texture slots: its coverage shading averages them (shade_fragment).
+inline bool textured(const TriangleSetup& t) {
+  return t.shading != nullptr && t.shading->surface->has_texture_slots;
+}
+
+/// Whether the resolve gives fragment `t` shade_fragment_visible's colour: it is textured, it
+/// keeps `kept_count` of its `own_count` samples (some, not all), and the lost ones stand for
+/// at least kVisibleShadingMinShare of the pixel at its weight `weight` [pixels].
+inline bool shows_side(const TriangleSetup& t, double weight, int own_count, int kept_count) {
+  return textured(t) && kept_count > 0 && kept_count < own_count &&
+         weight * double(own_count - kept_count) / own_count >= kVisibleShadingMinShare;
+}
+
 /// The colour of a textured fragment of which a nearer one hides some samples: shade_fragment
 /// over its whole part, moved towards its shown side. With W the mean over the part and V, H
 /// the means over the shown and the hidden side, in proportions k and h of its samples (k + h
@@ -84,9 +97,7 @@ glm::vec3 shade_fragment_visible(const TriangleSetup& t, int x, int y, const Sam
 
 /// The colour coverage mode gives the fragment of `t` in pixel (x, y).
 inline glm::vec3 shade_fragment(const TriangleSetup& t, int x, int y) {
-  if (t.shading != nullptr && t.shading->surface->has_texture_slots) {
-    return shade_fragment_averaged(t, x, y);
-  }
+  if (textured(t)) return shade_fragment_averaged(t, x, y);
   return shade(t, x + 0.5, y + 0.5, true);
 }
 

@@ -98,6 +98,11 @@ struct SampleMask {
     return SampleMask{
         {word[0] & o.word[0], word[1] & o.word[1], word[2] & o.word[2], word[3] & o.word[3]}};
   }
+  /// The samples of this mask that `o` does not have.
+  SampleMask without(const SampleMask& o) const {
+    return SampleMask{
+        {word[0] & ~o.word[0], word[1] & ~o.word[1], word[2] & ~o.word[2], word[3] & ~o.word[3]}};
+  }
   SampleMask operator|(const SampleMask& o) const {
     SampleMask m = *this;
     return m |= o;
