@@ -69,6 +69,18 @@ struct SurfaceTextures {
   const TextureSlot* anisotropy = nullptr;  ///< KHR_materials_anisotropy: RG direction, B strength
   const TextureSlot* transmission = nullptr;  ///< KHR_materials_transmission, R
   const TextureSlot* thickness = nullptr;     ///< KHR_materials_volume, G
+
+  /// How many slots hold a texture.
+  int count() const {
+    int n = 0;
+    for (const TextureSlot* slot :
+         {base_color, metallic_roughness, normal, occlusion, emissive, specular, specular_color,
+          clearcoat, clearcoat_roughness, clearcoat_normal, sheen_color, sheen_roughness,
+          iridescence, iridescence_thickness, anisotropy, transmission, thickness}) {
+      n += slot != nullptr;
+    }
+    return n;
+  }
 };
 
 /// The fragment over which sample_surface averages its textures
@@ -84,6 +96,9 @@ struct FragmentFootprint {
   /// points whose alpha passes: the texels the cutoff removes must not tint it).
   bool has_base_color = false;
   glm::dvec4 base_color{1.0};
+  /// Where the slots averaged over this fragment keep their polygon's cuts for each other
+  /// (set by sample_surface when it averages more than one slot); none: each cuts its own.
+  LevelCutsMemo* cuts = nullptr;
 };
 
 /// One material of one mesh instance, resolved (scene overrides applied).

@@ -5,6 +5,7 @@
 // so a point is textured alike in every mode, tile and thread.
 #include "shading/shading.hpp"
 #include "shading/shading_inputs.hpp"
+#include "texture/level_cuts.hpp"
 #include "texture/texture_sampling.hpp"
 
 #include <cmath>
@@ -86,8 +87,8 @@ glm::dvec4 footprint_average(const TriangleSetup& t, const TextureSlot& slot, co
                              const FragmentFootprint& footprint, const glm::dvec2& centre,
                              double lod) {
   if (footprint.vertex_count >= 3) {
-    if (const auto mean =
-            area_average(*slot.texture, slot.sampler, slot_polygon(slot, uv, footprint), lod)) {
+    if (const auto mean = area_average(*slot.texture, slot.sampler,
+                                       slot_polygon(slot, uv, footprint), lod, footprint.cuts)) {
       return *mean;
     }
   }
@@ -298,6 +299,14 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   out.thickness = s.thickness;
   const double mu[3] = {mu0, mu1, mu2};
   const WeightDerivatives d = weight_derivatives(t, mu0, mu1, mu2);
+  // Slots on one UV set and texture size average over the same polygon on the same levels:
+  // they share its cuts (the same bits as cutting it for each).
+  FragmentFootprint shared;
+  if (footprint != nullptr && footprint->cuts == nullptr && slots.count() > 1) {
+    shared = *footprint;
+    shared.cuts = &LevelCutsMemo::of_this_thread();
+    footprint = &shared;
+  }
   // One tangent frame per point, of the interpolated normal: the normal map's, the clearcoat
   // normal map's (which perturbs the interpolated normal too) and anisotropy's.
   const bool needs_frame =

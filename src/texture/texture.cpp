@@ -3,6 +3,7 @@
 // linear light by a 256-entry table. Double precision throughout, no contraction: the same
 // bits in every mode, tile, thread and compiler.
 #include "color/srgb.hpp"
+#include "texture/level_cuts.hpp"
 #include "texture/texture_sampling.hpp"
 
 #include <covrast/error.hpp>
@@ -208,15 +209,6 @@ double texture_lod(const Texture& texture, const glm::dvec2& duv_dx, const glm::
 
 namespace {
 
-/// A texel coordinate as a wrapped index: NaN and huge values (a UV far outside any
-/// sensible range) are pinned first, so the integer conversion is defined.
-long long texel_floor(double v) {
-  constexpr double kLimit = 1e15;
-  if (!(v > -kLimit)) return -static_cast<long long>(kLimit);
-  if (!(v < kLimit)) return static_cast<long long>(kLimit);
-  return static_cast<long long>(std::floor(v));
-}
-
 /// One level filtered at `uv`, each fetched texel decoded to linear light (`decode`) before it
 /// is weighted: the filter works in linear light.
 glm::dvec4 sample_level(const TextureLevel& level, const TexelDecoder& decode,
@@ -283,38 +275,9 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
 
 namespace {
 
-/// The cells of one level an average may reach: 8 x 8, a footprint of several texels
-/// (coverage mode asks on levels whose texels are about a pixel wide).
-constexpr long long kMaxCells = 64;
-/// The texels those cells read: (64 + 1) x (1 + 1) at most, for the bilinear filter.
+/// The texels the cells of an average read: (64 + 1) x (1 + 1) at most, for the bilinear
+/// filter.
 constexpr int kMaxTexels = 130;
-
-/// The integrals over `q` of 1, a, b and a b, with a = s - s0, b = t - t0, signed by its
-/// orientation (Green's theorem; Steger, "On the calculation of arbitrary moments of
-/// polygons", 1996): with c_i = a_i b_j - a_j b_i, j = i + 1,
-///   M_1 = sum c_i / 2,  M_a = sum (a_i + a_j) c_i / 6,  M_b = sum (b_i + b_j) c_i / 6,
-///   M_ab = sum (2 a_i b_i + a_i b_j + a_j b_i + 2 a_j b_j) c_i / 24.
-struct Moments {
-  double m1 = 0.0, ma = 0.0, mb = 0.0, mab = 0.0;
-};
-
-Moments moments(const ConvexPolygon& q, double s0, double t0) {
-  Moments m;
-  for (int i = 0; i < q.n; ++i) {
-    const int j = i + 1 == q.n ? 0 : i + 1;
-    const double ai = q.x[i] - s0, bi = q.y[i] - t0, aj = q.x[j] - s0, bj = q.y[j] - t0;
-    const double c = ai * bj - aj * bi;
-    m.m1 += c;
-    m.ma += (ai + aj) * c;
-    m.mb += (bi + bj) * c;
-    m.mab += (2.0 * ai * bi + ai * bj + aj * bi + 2.0 * aj * bj) * c;
-  }
-  m.m1 *= 1.0 / 2.0;
-  m.ma *= 1.0 / 6.0;
-  m.mb *= 1.0 / 6.0;
-  m.mab *= 1.0 / 24.0;
-  return m;
-}
 
 /// Texel values g_0..g_{n-1} along one axis (`stride` apart) rewritten in place as the
 /// coefficients of a basis with one kink per inner node k = s0 + 1, s0 + 2, ...:
@@ -334,77 +297,48 @@ void to_kink_basis(glm::dvec4* g, int n, int stride, int order) {
   if (n >= 2) g[stride] -= g[0];
 }
 
+/// The texels a filter of order 0 (NEAREST) or 1 (LINEAR) reads over the cells `cuts` reach,
+/// decoded, row by row (columns + order per row, rows + order rows; first i0, j0), wrapped as
+/// sample_level wraps them.
+struct TexelBlock {
+  int n = 0, m = 0;  ///< texels per row, rows of texels
+  glm::dvec4 texel[kMaxTexels];
+};
+
+void read_block(const TextureLevel& level, const TexelDecoder& decode,
+                const TextureSampler& sampler, const LevelPolygon& at, int order,
+                TexelBlock& block) {
+  block.n = at.columns + order;
+  block.m = at.rows + order;
+  for (int y = 0; y < block.m; ++y) {
+    const int row = wrap_texel(at.j0 + y, level.height, sampler.wrap_t);
+    for (int x = 0; x < block.n; ++x) {
+      block.texel[y * block.n + x] =
+          decode(level.at(wrap_texel(at.i0 + x, level.width, sampler.wrap_s), row));
+    }
+  }
+}
+
 /// The mean of one level over `uv`, filtered NEAREST (order 0) or LINEAR (order 1), exactly.
-/// In s, t (s = u W for NEAREST, whose texel i is the cell [i, i + 1]; s = u W - 1/2 for
-/// LINEAR, whose texel centres are the integers) the filter over the cells the polygon's
-/// bounds reach is the texel block rewritten by to_kink_basis along both axes, times products
-/// A_x(s) B_y(t) of the basis functions. Each product's integral over the polygon P is a
-/// moment of a piece of P: with S_k = P n {s >= k} and T_l = P n {t >= l},
+/// In s, t (level_cuts.hpp) the filter over the cells the polygon's bounds reach is the texel
+/// block rewritten by to_kink_basis along both axes, times products A_x(s) B_y(t) of the
+/// basis functions. Each product's integral over the polygon P is a moment of a piece of P:
+/// with S_k = P n {s >= k} and T_l = P n {t >= l},
 ///   steps:  int_P step(s - k) step(t - l) = M_1(S_k n T_l)
 ///   ramps:  int_P r(s - k) r(t - l) = M_ab(S_k n T_l) about (k, l),
 ///           int_P r(s - k) (t - t0) = M_ab(S_k) about (k, t0), and so on,
 /// so the pieces are P cut by at most two half-planes: one per inner node on each axis and one
-/// per pair, where clipping every cell would cut four per cell. The texels wrap as
-/// sample_level wraps them. Nothing when P has no area or its bounds reach more than
-/// kMaxCells cells.
-/// The block of texels a filter of order 0 (NEAREST) or 1 (LINEAR) reads over a polygon:
-/// the polygon in s, t (s = u W for NEAREST, whose texel i is the cell [i, i + 1]; s = u W - 1/2
-/// for LINEAR, whose texel centres are the integers), the cells its bounds reach (first
-/// i0, j0) and their texels, decoded, row by row (columns + order per row).
-struct TexelBlock {
-  ConvexPolygon p;
-  long long i0 = 0, j0 = 0;
-  int columns = 0, rows = 0;  ///< cells
-  int n = 0, m = 0;           ///< texels per row, rows of texels
-  glm::dvec4 texel[kMaxTexels];
-};
-
-/// Fills `block` for `uv` on `level`; false when `uv` is not a polygon or its bounds reach
-/// more than kMaxCells cells.
-bool read_block(const TextureLevel& level, const TexelDecoder& decode,
-                const TextureSampler& sampler, const ConvexPolygon& uv, int order,
-                TexelBlock& block) {
-  ConvexPolygon& p = block.p;
-  p = uv;
-  double s_min = HUGE_VAL, t_min = HUGE_VAL, s_max = -HUGE_VAL, t_max = -HUGE_VAL;
-  for (int i = 0; i < p.n; ++i) {
-    p.x[i] = p.x[i] * level.width - 0.5 * order;
-    p.y[i] = p.y[i] * level.height - 0.5 * order;
-    s_min = std::min(s_min, p.x[i]);
-    s_max = std::max(s_max, p.x[i]);
-    t_min = std::min(t_min, p.y[i]);
-    t_max = std::max(t_max, p.y[i]);
-  }
-  const long long i0 = texel_floor(s_min), i1 = texel_floor(s_max);
-  const long long j0 = texel_floor(t_min), j1 = texel_floor(t_max);
-  if (p.n < 3 || i1 - i0 >= kMaxCells || j1 - j0 >= kMaxCells ||
-      (i1 - i0 + 1) * (j1 - j0 + 1) > kMaxCells) {
-    return false;
-  }
-  block.i0 = i0;
-  block.j0 = j0;
-  block.columns = int(i1 - i0) + 1;
-  block.rows = int(j1 - j0) + 1;
-  block.n = block.columns + order;
-  block.m = block.rows + order;
-  for (int y = 0; y < block.m; ++y) {
-    const int row = wrap_texel(j0 + y, level.height, sampler.wrap_t);
-    for (int x = 0; x < block.n; ++x) {
-      block.texel[y * block.n + x] =
-          decode(level.at(wrap_texel(i0 + x, level.width, sampler.wrap_s), row));
-    }
-  }
-  return true;
-}
-
-template <int kOrder>
+/// per pair, where clipping every cell would cut four per cell. `cuts` (DirectCuts or
+/// LevelCuts, level_cuts.hpp) cuts the pieces; the texels decide which are needed. Nothing
+/// when P has no area or its bounds reach more than kMaxCells cells.
+template <int kOrder, class Cuts>
 std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
-                                        const TextureSampler& sampler, const ConvexPolygon& uv) {
+                                        const TextureSampler& sampler, Cuts& cuts) {
+  const LevelPolygon& at = cuts.at();
+  if (!at.fits) return std::nullopt;
   TexelBlock block;
-  if (!read_block(level, decode, sampler, uv, kOrder, block)) return std::nullopt;
-  const ConvexPolygon& p = block.p;
-  const long long i0 = block.i0, j0 = block.j0;
-  const int columns = block.columns, rows = block.rows, n = block.n, m = block.m;
+  read_block(level, decode, sampler, at, kOrder, block);
+  const int columns = at.columns, rows = at.rows, n = block.n, m = block.m;
   glm::dvec4* c = block.texel;
   for (int y = 0; y < m; ++y) to_kink_basis(c + y * n, n, 1, kOrder);
   for (int x = 0; x < n; ++x) to_kink_basis(c + x, m, n, kOrder);
@@ -419,7 +353,7 @@ std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDe
     }
     return true;
   };
-  const Moments whole = moments(p, double(i0), double(j0));
+  const Moments& whole = at.whole;
   const double area = whole.m1;
   if (!(std::fabs(area) > 1e-12)) return std::nullopt;
   if (kOrder == 0 && n * m == 1) return c[0];  // inside one texel: its value
@@ -427,47 +361,52 @@ std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDe
   for (int ps = 0; ps < columns; ++ps) {
     const int x = ps + kOrder;  // the basis function of the cut at s = i0 + ps
     if (ps > 0 && column_is_zero(x)) continue;
-    const double s0 = double(i0 + ps);
-    const ConvexPolygon column_piece = ps == 0 ? p : clip_half_plane(p, 1.0, 0.0, -s0);
-    if (column_piece.n < 3) break;
+    if (ps > 0 && cuts.column(ps) == nullptr) break;
     for (int pt = 0; pt < rows; ++pt) {
       const int y = pt + kOrder;
       if (pt > 0 && zero(c[y * n + x]) && (ps > 0 || zero(c[y * n]))) continue;
-      const double t0 = double(j0 + pt);
-      const ConvexPolygon piece =
-          pt == 0 ? column_piece : clip_half_plane(column_piece, 0.0, 1.0, -t0);
-      if (piece.n < 3) break;
-      const Moments q = ps == 0 && pt == 0 ? whole : moments(piece, s0, t0);
+      const Moments* q = ps == 0 && pt == 0 ? &whole : cuts.piece(ps, pt);
+      if (q == nullptr) break;
       if constexpr (kOrder == 0) {
-        sum += c[y * n + x] * q.m1;
+        sum += c[y * n + x] * q->m1;
       } else {
         // The ramp basis functions on this piece: x = 1 ((s - i0) on P) or ps + 1
         // (r(s - i0 - ps)), and the constant x = 0 on P alone; the same for y.
-        sum += c[y * n + x] * q.mab;
-        if (ps == 0) sum += c[y * n] * q.mb;
-        if (pt == 0) sum += c[x] * q.ma;
-        if (ps == 0 && pt == 0) sum += c[0] * q.m1;
+        sum += c[y * n + x] * q->mab;
+        if (ps == 0) sum += c[y * n] * q->mb;
+        if (pt == 0) sum += c[x] * q->ma;
+        if (ps == 0 && pt == 0) sum += c[0] * q->m1;
       }
     }
   }
   return sum / area;
 }
 
+/// level_average with the filter's order, on `memo`'s cuts when there is one.
 std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDecoder& decode,
                                         const TextureSampler& sampler, const ConvexPolygon& uv,
-                                        TextureFilter filter) {
-  return filter == TextureFilter::Nearest ? level_average<0>(level, decode, sampler, uv)
-                                          : level_average<1>(level, decode, sampler, uv);
+                                        TextureFilter filter, LevelCutsMemo* memo) {
+  const int order = filter == TextureFilter::Nearest ? 0 : 1;
+  if (memo != nullptr) {
+    LevelCuts& cuts = memo->get(level.width, level.height, uv, order);
+    return order == 0 ? level_average<0>(level, decode, sampler, cuts)
+                      : level_average<1>(level, decode, sampler, cuts);
+  }
+  DirectCuts cuts(level.width, level.height, uv, order);
+  return order == 0 ? level_average<0>(level, decode, sampler, cuts)
+                    : level_average<1>(level, decode, sampler, cuts);
 }
 
 /// The smallest and largest alpha of the texels `filter` reads over `uv` on `level`.
 std::optional<AlphaRange> level_alpha_range(const TextureLevel& level, const TexelDecoder& decode,
                                             const TextureSampler& sampler, const ConvexPolygon& uv,
                                             TextureFilter filter) {
+  const int order = filter == TextureFilter::Nearest ? 0 : 1;
+  LevelPolygon at;
+  at.set(level.width, level.height, uv, order);
+  if (!at.fits) return std::nullopt;
   TexelBlock block;
-  if (!read_block(level, decode, sampler, uv, filter == TextureFilter::Nearest ? 0 : 1, block)) {
-    return std::nullopt;
-  }
+  read_block(level, decode, sampler, at, order, block);
   AlphaRange range{HUGE_VAL, -HUGE_VAL};
   for (int k = 0; k < block.n * block.m; ++k) {
     range.low = std::min(range.low, block.texel[k].a);
@@ -493,15 +432,15 @@ std::optional<AlphaRange> area_alpha_range(const Texture& texture, const Texture
 }
 
 std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
-                                       const ConvexPolygon& uv, double lod) {
+                                       const ConvexPolygon& uv, double lod, LevelCutsMemo* memo) {
   if (texture.levels.empty()) return std::nullopt;
   const TexelDecoder decode(texture.srgb);
   const LevelChoice c = choose_levels(texture, sampler, lod);  // as sample_texture reads them
   const std::optional<glm::dvec4> a =
-      level_average(texture.levels[std::size_t(c.first)], decode, sampler, uv, c.filter);
+      level_average(texture.levels[std::size_t(c.first)], decode, sampler, uv, c.filter, memo);
   if (c.second < 0 || !a) return a;
   const std::optional<glm::dvec4> b =
-      level_average(texture.levels[std::size_t(c.second)], decode, sampler, uv, c.filter);
+      level_average(texture.levels[std::size_t(c.second)], decode, sampler, uv, c.filter, memo);
   if (!b) return std::nullopt;
   return *a * (1.0 - c.weight) + *b * c.weight;
 }

@@ -14,6 +14,8 @@
 
 namespace covrast::detail {
 
+class LevelCutsMemo;
+
 /// Texel index `i` (any integer) of a side of `size` texels after the wrap mode:
 ///   REPEAT           i mod size (non-negative remainder)
 ///   MIRRORED_REPEAT  k = i mod 2 size; k < size ? k : 2 size - 1 - k
@@ -42,9 +44,12 @@ glm::dvec4 sample_texture(const Texture& texture, const TextureSampler& sampler,
 ///   LINEAR   the bilinear filter integrated over the polygon's part in each cell between
 ///            four texel centres (its moments 1, a, b, a b), divided by area(polygon);
 /// texels wrapped as sample_texture wraps them. Nothing when the polygon has no area or
-/// reaches more than 64 texel cells of a level.
+/// reaches more than 64 texel cells of a level. With a `memo`, the polygon's pieces on each
+/// level are cut once for every texture of that size (level_cuts.hpp): the same bits, less
+/// work when several textures are averaged over one polygon.
 std::optional<glm::dvec4> area_average(const Texture& texture, const TextureSampler& sampler,
-                                       const ConvexPolygon& uv, double lod);
+                                       const ConvexPolygon& uv, double lod,
+                                       LevelCutsMemo* memo = nullptr);
 
 /// Bounds of a filtered alpha: every value lies in [low, high].
 struct AlphaRange {
