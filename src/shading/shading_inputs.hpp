@@ -82,6 +82,8 @@ struct SurfaceTextures {
     return n;
   }
 };
+static_assert(sizeof(SurfaceTextures) == 17 * sizeof(const TextureSlot*),
+              "SurfaceTextures::count() lists every slot");
 
 /// The fragment over which sample_surface averages its textures
 /// (raster/coverage/fragment_shading.hpp makes it): pixel (x, y) and the vertices of the
