@@ -66,40 +66,12 @@ SurfaceTextures surface_slots(const Material& m, bool lit) {
   return out;
 }
 
-/// Every slot of `t`, null where the material has none.
-std::array<const TextureSlot*, 17> all_slots(const SurfaceTextures& t) {
-  return {t.base_color,
-          t.metallic_roughness,
-          t.normal,
-          t.occlusion,
-          t.emissive,
-          t.specular,
-          t.specular_color,
-          t.clearcoat,
-          t.clearcoat_roughness,
-          t.clearcoat_normal,
-          t.sheen_color,
-          t.sheen_roughness,
-          t.iridescence,
-          t.iridescence_thickness,
-          t.anisotropy,
-          t.transmission,
-          t.thickness};
-}
-
-bool any_texture(const SurfaceTextures& t) {
-  for (const TextureSlot* slot : all_slots(t)) {
-    if (slot != nullptr) return true;
-  }
-  return false;
-}
-
 }  // namespace
 
 bool GeometryFrontEnd::shows_textures(const Scene& scene) {
   for (const MeshInstance& instance : scene.meshes) {
     for (const Material& m : instance.materials) {
-      if (any_texture(surface_slots(m, scene.lit))) return true;
+      if (surface_slots(m, scene.lit).count() > 0) return true;
     }
   }
   return false;
@@ -188,8 +160,10 @@ void GeometryFrontEnd::prepare_lighting() {
           std::cbrt(std::abs(glm::determinant(glm::dmat3(scene_.meshes[i].model))));
       // An anisotropic pbr surface needs the tangent frame that textured triangles carry,
       // whether or not it has textures.
-      surface.has_texture_slots = any_texture(textures_[i][k]);
-      if (surface.has_texture_slots || surface.anisotropic()) surface.textures = &textures_[i][k];
+      surface.texture_slot_count = textures_[i][k].count();
+      if (surface.texture_slot_count > 0 || surface.anisotropic()) {
+        surface.textures = &textures_[i][k];
+      }
       surfaces_[i].push_back(surface);
       if ((scene_.lit && materials[k].model != ShadingModel::Unlit) || surface.textures) {
         lit_[i] = true;

@@ -14,6 +14,7 @@
 
 #include <glm/glm.hpp>
 
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -70,20 +71,35 @@ struct SurfaceTextures {
   const TextureSlot* transmission = nullptr;  ///< KHR_materials_transmission, R
   const TextureSlot* thickness = nullptr;     ///< KHR_materials_volume, G
 
+  /// Every slot, null where the material has none.
+  std::array<const TextureSlot*, 17> all() const {
+    return {base_color,
+            metallic_roughness,
+            normal,
+            occlusion,
+            emissive,
+            specular,
+            specular_color,
+            clearcoat,
+            clearcoat_roughness,
+            clearcoat_normal,
+            sheen_color,
+            sheen_roughness,
+            iridescence,
+            iridescence_thickness,
+            anisotropy,
+            transmission,
+            thickness};
+  }
   /// How many slots hold a texture.
   int count() const {
     int n = 0;
-    for (const TextureSlot* slot :
-         {base_color, metallic_roughness, normal, occlusion, emissive, specular, specular_color,
-          clearcoat, clearcoat_roughness, clearcoat_normal, sheen_color, sheen_roughness,
-          iridescence, iridescence_thickness, anisotropy, transmission, thickness}) {
-      n += slot != nullptr;
-    }
+    for (const TextureSlot* slot : all()) n += slot != nullptr;
     return n;
   }
 };
 static_assert(sizeof(SurfaceTextures) == 17 * sizeof(const TextureSlot*),
-              "SurfaceTextures::count() lists every slot");
+              "SurfaceTextures::all() lists every slot");
 
 /// The fragment over which sample_surface averages its textures
 /// (raster/coverage/fragment_shading.hpp makes it): pixel (x, y) and the vertices of the
@@ -157,8 +173,9 @@ struct SurfaceShading {
   /// work at all), and for an Unlit one without a base colour texture. An anisotropic surface
   /// has them, for the tangent frame its triangles then carry, even when no slot is set.
   const SurfaceTextures* textures = nullptr;
-  /// Some slot of `textures` is set: what coverage mode averages over a fragment.
-  bool has_texture_slots = false;
+  /// How many slots of `textures` are set (SurfaceTextures::count): what coverage mode
+  /// averages over a fragment, sharing their cuts when there are several.
+  int texture_slot_count = 0;
 };
 
 /// What a textured triangle adds to its ShadingRecord, in the TriangleSetup's vertex order:

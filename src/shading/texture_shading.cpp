@@ -302,7 +302,7 @@ SurfaceSample sample_surface(const TriangleSetup& t, double mu0, double mu1, dou
   // Slots on one UV set and texture size average over the same polygon on the same levels:
   // they share its cuts (the same bits as cutting it for each).
   FragmentFootprint shared;
-  if (footprint != nullptr && footprint->cuts == nullptr && slots.count() > 1) {
+  if (footprint != nullptr && footprint->cuts == nullptr && s.texture_slot_count > 1) {
     shared = *footprint;
     shared.cuts = &LevelCutsMemo::of_this_thread();
     footprint = &shared;

@@ -26,6 +26,11 @@ Moments moments(const ConvexPolygon& q, double s0, double t0) {
 }
 
 void LevelPolygon::set(int width, int height, const ConvexPolygon& uv, int order) {
+  set_cells(width, height, uv, order);
+  whole = fits ? moments(p, double(i0), double(j0)) : Moments{};
+}
+
+void LevelPolygon::set_cells(int width, int height, const ConvexPolygon& uv, int order) {
   p.n = uv.n;
   double s_min = HUGE_VAL, t_min = HUGE_VAL, s_max = -HUGE_VAL, t_max = -HUGE_VAL;
   for (int i = 0; i < uv.n; ++i) {
@@ -43,7 +48,6 @@ void LevelPolygon::set(int width, int height, const ConvexPolygon& uv, int order
          (i1 - i0 + 1) * (j1 - j0 + 1) <= kMaxCells;
   columns = fits ? int(i1 - i0) + 1 : 0;
   rows = fits ? int(j1 - j0) + 1 : 0;
-  whole = fits ? moments(p, double(i0), double(j0)) : Moments{};
 }
 
 void LevelCuts::reset(int width, int height, const ConvexPolygon& uv, int order) {

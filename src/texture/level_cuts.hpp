@@ -46,8 +46,11 @@ struct LevelPolygon {
   bool fits = false;  ///< P has 3 or more vertices and reaches at most kMaxCells cells
   long long i0 = 0, j0 = 0;
   int columns = 0, rows = 0;
-  Moments whole;
+  Moments whole;  ///< set() only
+  /// P, its cells and its moments.
   void set(int width, int height, const ConvexPolygon& uv, int order);
+  /// P and its cells only (what the texels read need).
+  void set_cells(int width, int height, const ConvexPolygon& uv, int order);
 };
 
 /// S_ps = P n {s >= i0 + ps} (0 < ps < columns) into `column`; false when it has fewer

@@ -387,14 +387,13 @@ std::optional<glm::dvec4> level_average(const TextureLevel& level, const TexelDe
                                         const TextureSampler& sampler, const ConvexPolygon& uv,
                                         TextureFilter filter, LevelCutsMemo* memo) {
   const int order = filter == TextureFilter::Nearest ? 0 : 1;
-  if (memo != nullptr) {
-    LevelCuts& cuts = memo->get(level.width, level.height, uv, order);
+  const auto average = [&](auto& cuts) {
     return order == 0 ? level_average<0>(level, decode, sampler, cuts)
                       : level_average<1>(level, decode, sampler, cuts);
-  }
+  };
+  if (memo != nullptr) return average(memo->get(level.width, level.height, uv, order));
   DirectCuts cuts(level.width, level.height, uv, order);
-  return order == 0 ? level_average<0>(level, decode, sampler, cuts)
-                    : level_average<1>(level, decode, sampler, cuts);
+  return average(cuts);
 }
 
 /// The smallest and largest alpha of the texels `filter` reads over `uv` on `level`.
@@ -403,7 +402,7 @@ std::optional<AlphaRange> level_alpha_range(const TextureLevel& level, const Tex
                                             TextureFilter filter) {
   const int order = filter == TextureFilter::Nearest ? 0 : 1;
   LevelPolygon at;
-  at.set(level.width, level.height, uv, order);
+  at.set_cells(level.width, level.height, uv, order);
   if (!at.fits) return std::nullopt;
   TexelBlock block;
   read_block(level, decode, sampler, at, order, block);

@@ -69,7 +69,7 @@ inline constexpr double kVisibleShadingMinShare = 0.01;
 
 /// Whether `t` has texture slots: its coverage shading averages them (shade_fragment).
 inline bool textured(const TriangleSetup& t) {
-  return t.shading != nullptr && t.shading->surface->has_texture_slots;
+  return t.shading != nullptr && t.shading->surface->texture_slot_count > 0;
 }
 
 /// Whether the resolve gives fragment `t` shade_fragment_visible's colour: it is textured, it
