@@ -994,19 +994,31 @@ TEST_CASE("coverage mode: interpenetrating triangles resolve per sub-pixel sampl
     add_triangle_pair(s, a, red, b, sky, one_mesh);
     const std::vector<TriangleSetup> tris = screen_triangles(s);
     REQUIRE(tris.size() == 2);
-    // Where the crossing line meets a triangle's edge, the samples decide: the log's sample
-    // masks (planes compared per sample where depth ranges overlap), or the list's samples.
-    for (bool list_only : {false, true}) {
-      const covrast::test::ScopedHook hook(covrast::detail::testing::coverage_hooks.list_only,
-                                           list_only);
-      const auto result = render(s, ModeKind::Coverage);
-      const Comparison c = compare(result.color, reference_render(s, tris));
-      WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes")
-                                << (list_only ? ", list" : ", log") << ": " << describe(c));
-      const covrast::CoverageResolvePaths& paths = result.stats.resolve_paths;
-      CHECK((list_only ? paths.samples : paths.masked) > 0);
-      CHECK(c.max_diff_linear <= kMaskToleranceLinear);
-      CHECK(c.mean_diff8 < 0.1);
+    // Where the crossing line meets a triangle's edge, the fragments' visible parts are
+    // clipped exactly (visible_parts.hpp); without the clipping the samples decide: the log's
+    // sample masks (planes compared per sample where depth ranges overlap), or the list's
+    // samples.
+    for (bool clipping : {true, false}) {
+      for (bool list_only : {false, true}) {
+        const covrast::test::ScopedHook hook(covrast::detail::testing::coverage_hooks.list_only,
+                                             list_only);
+        const covrast::test::ScopedHook clip(covrast::detail::testing::coverage_hooks.no_clipping,
+                                             !clipping);
+        const auto result = render(s, ModeKind::Coverage);
+        const Comparison c = compare(result.color, reference_render(s, tris));
+        WARN("interpenetrating, " << (one_mesh ? "one mesh" : "two meshes")
+                                  << (list_only ? ", list" : ", log")
+                                  << (clipping ? ", clipped" : ", samples") << ": " << describe(c));
+        const covrast::CoverageResolvePaths& paths = result.stats.resolve_paths;
+        if (clipping) {
+          CHECK(paths.clipped > 0);
+          CHECK(paths.samples + paths.masked == 0);
+        } else {
+          CHECK((list_only ? paths.samples : paths.masked) > 0);
+        }
+        CHECK(c.max_diff_linear <= kMaskToleranceLinear);
+        CHECK(c.mean_diff8 < 0.1);
+      }
     }
   }
 }

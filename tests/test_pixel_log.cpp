@@ -231,6 +231,11 @@ TEST_CASE("pixel log: proven layers give the list's bytes, and every path is tak
   covrast::test::add_instance(s, covrast::test::uv_sphere(40, 80), glm::vec3(1),
                               covrast::ColorSource::PerTriangle);
   s.meshes.back().model[3] = glm::dvec4(0.55, 0.0, -0.3, 1.0);
+  const covrast::RenderResult clipped = render_coverage(s, false);
+  // The log against the list, both with the masks and samples alone (the clipping is exact
+  // where they estimate, so it would show as a difference between them).
+  const covrast::test::ScopedHook no_clipping(covrast::detail::testing::coverage_hooks.no_clipping,
+                                              true);
   const covrast::RenderResult log = render_coverage(s, false);
   const covrast::RenderResult list = render_coverage(s, true);
   const covrast::CoverageResolvePaths& paths = log.stats.resolve_paths;
@@ -253,6 +258,13 @@ TEST_CASE("pixel log: proven layers give the list's bytes, and every path is tak
                     << list_ref.rmse_linear << ", max " << list_ref.max_diff_srgb8);
   CHECK(log_ref.rmse_linear <= 1.05 * list_ref.rmse_linear);
   CHECK(log_ref.max_diff_srgb8 <= list_ref.max_diff_srgb8 + 1);
+  // The default render clips the small mixed logs exactly: closer to the reference.
+  const covrast::CompareResult clipped_ref = covrast::compare_images(clipped.color, ref);
+  INFO("clipped: rmse " << clipped_ref.rmse_linear << ", max " << clipped_ref.max_diff_srgb8
+                        << ", pixels " << clipped.stats.resolve_paths.clipped);
+  CHECK(clipped.stats.resolve_paths.clipped > 20);
+  CHECK(clipped_ref.rmse_linear <= log_ref.rmse_linear);
+  CHECK(clipped_ref.max_diff_srgb8 <= log_ref.max_diff_srgb8);
 }
 
 TEST_CASE("pixel log: the same bytes for every thread count and tile size", "[coverage][log]") {
@@ -265,6 +277,10 @@ TEST_CASE("pixel log: the same bytes for every thread count and tile size", "[co
       s, "coverage", covrast::test::every_split({1, 2, 3}, {8, 16, 32}),
       [](const covrast::RenderResult& r, const covrast::RenderResult& b, covrast::test::Split) {
         CHECK(r.stats.resolve_paths.masked == b.stats.resolve_paths.masked);
+        CHECK(r.stats.resolve_paths.clipped == b.stats.resolve_paths.clipped);
       });
-  CHECK(base.stats.resolve_paths.masked > 100);  // folds at the silhouette: two layers
+  // Folds at the silhouette, two layers: the larger mixed logs take the masks, the smaller
+  // the clipping.
+  CHECK(base.stats.resolve_paths.masked > 50);
+  CHECK(base.stats.resolve_paths.clipped > 5);
 }

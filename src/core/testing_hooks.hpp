@@ -49,6 +49,10 @@ struct CoverageHooks {
   /// goes to the A-buffer's fragment list at once, as it did before the log (the list's
   /// paths then run on any scene; the log's resolve differs from it within the tests' bounds).
   std::atomic<bool> list_only{false};
+  /// Read once per tile: no pixel takes the exact clipping of its fragments' visible parts
+  /// (raster/coverage/visible_parts.hpp), and a full list never drops its hidden fragments;
+  /// they take the masks and samples instead, the estimate the clipping is measured against.
+  std::atomic<bool> no_clipping{false};
   /// Read when an A-buffer is made: it keeps at most this many fragments per pixel (clamped
   /// to 2..kMaxFragmentsPerPixel; 0 = kMaxFragmentsPerPixel), so that small scenes reach the
   /// overflow policy.

@@ -76,7 +76,8 @@ ABufferTile::ABufferTile(int tile_px)
       mixed_capacity_(std::min(capacity_, kMaxMixedFragments)),
       block_stride_((tile_px + kBlockPx - 1) / kBlockPx),
       log_(std::size_t(tile_px) * tile_px),
-      log_on_(true) {
+      log_on_(true),
+      clipping_on_(true) {
   const std::size_t blocks = std::size_t(block_stride_) * std::size_t(block_stride_);
   block_uniform_.resize(blocks);
   block_opaque_.resize(blocks);
@@ -106,6 +107,7 @@ void ABufferTile::begin_tile(const PixelRect& rect) {
   pool_.clear();
   log_.clear_entries();
   log_on_ = !testing::coverage_hooks.list_only.load(std::memory_order_relaxed);
+  clipping_on_ = !testing::coverage_hooks.no_clipping.load(std::memory_order_relaxed);
   merged_slot_.clear();
   merged_.clear();
   samples_.clear();

@@ -255,6 +255,12 @@ class ABufferTile {
   /// fragment holds are hidden (per sample by the planes where depth ranges overlap), and a
   /// fragment weighs its exact area times the share of its samples it keeps.
   void resolve_masked(std::size_t pixel, int x, int y, glm::vec3 background);
+  /// A log of at most kMaxClippedLog untextured fragments: each one's exact visible area
+  /// (visible_parts.hpp) over the opaque surface or the background; false (nothing written)
+  /// for any other log. Beyond a few fragments the clipping's pairs (O(n^2)) cost more than
+  /// the masks, whose estimate is good where fragments are many and small.
+  bool resolve_clipped_log(std::size_t pixel, int x, int y, glm::vec3 background);
+  static constexpr int kMaxClippedLog = 6;
   static constexpr int kBlockPx = kAbufferBlockPx;
   std::size_t block_of(int x, int y) const {
     return std::size_t((y - rect_.y0) / kBlockPx) * block_stride_ + (x - rect_.x0) / kBlockPx;
@@ -267,7 +273,19 @@ class ABufferTile {
   void materialize_block(std::size_t b);
   inline void add_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                            std::uint32_t coverage, double centre_z);
-  /// The list is full: the overflow policy; true when `t` was absorbed (always).
+  /// What drop_hidden did with a full list and a new fragment `t`.
+  enum class Compaction {
+    NewHidden,  ///< t is hidden: nothing more to do
+    Room,       ///< hidden fragments left the list, which has room for t again
+    Full,       ///< too little left it (or the list is not deep enough to try): samples
+  };
+  /// A mixed list at its limit whose areas add up to kCompactionDepth pixels or more (a
+  /// stack of layers, most of which cannot show): the fragments that the others and the
+  /// opaque surface hide all over their part of the pixel, by exact clipping, leave it.
+  Compaction drop_hidden(std::size_t pixel, int x, int y, const TriangleSetup& t);
+  static constexpr double kCompactionDepth = 4.0;
+  /// The list is full: the overflow policy; true when `t` was absorbed, false when
+  /// drop_hidden made room for it.
   bool overflow_fragment(std::size_t pixel, int x, int y, const TriangleSetup* t,
                          std::uint32_t coverage, double centre_z);
   /// Whether `t` overlaps no fragment of the pixel's open set (an empty set takes anything).
@@ -433,6 +451,8 @@ class ABufferTile {
   /// The pixels' logs (pixel_log.hpp); on unless testing::CoverageHooks::list_only.
   PixelLog log_;
   bool log_on_;
+  /// Mixed pixels may be resolved by exact clipping; on unless testing::CoverageHooks::no_clipping.
+  bool clipping_on_;
   std::vector<Fragment> pool_;
   std::vector<std::uint32_t> merged_slot_;  ///< per fragment, index into merged_ (when merged)
   std::vector<MergedPiece> merged_;

@@ -6,6 +6,7 @@
 #include "core/checks.hpp"
 #include "raster/coverage/abuffer_planes.hpp"
 #include "raster/coverage/fragment_shading.hpp"
+#include "raster/coverage/visible_parts.hpp"
 
 #include <algorithm>
 
@@ -129,5 +130,48 @@ void ABufferTile::complete_open_set(std::size_t pixel, int x, int y) {
     fragment.coverage |= kOpenFlag;
     ++open_count_[pixel];
   }
+}
+
+ABufferTile::Compaction ABufferTile::drop_hidden(std::size_t pixel, int x, int y,
+                                                 const TriangleSetup& t) {
+  // Visibility only shrinks as fragments arrive: a fragment that the stored ones and the
+  // opaque surface hide all over its part of the pixel never shows again.
+  if (!clipping_on_) return Compaction::Full;
+  const TriangleSetup* tri[kMaxVisibleFragments];
+  int n = 0;
+  double depth_px = 0.0;  // the list's summed coverage [pixels]
+  for (std::uint32_t f = head_[pixel]; f != kEnd; f = pool_[f].next) {
+    if ((pool_[f].coverage & kMergedFlag) || n + 1 == kMaxVisibleFragments) return Compaction::Full;
+    depth_px += double(pool_[f].coverage & kCoverageBits) / kCoverageOne;
+    tri[n++] = pool_[f].triangle;
+  }
+  // A shallower list is a dense mesh's pieces, which the clipping would mostly keep.
+  if (depth_px < kCompactionDepth) return Compaction::Full;
+  tri[n++] = &t;
+  double area[kMaxVisibleFragments];
+  if (!visible_areas(n, tri, opaque_[pixel], x, y, area)) return Compaction::Full;
+  // Where the visible parts fill the pixel, nothing behind the farthest of them shows: the
+  // depth bound of closed sets and samples, with their margin (filled to within 1e-9 of the
+  // pixel: what a farther fragment might show in the rest is far below an 8.8 step).
+  const TriangleSetup* opaque = opaque_[pixel];
+  double covered = 0.0;
+  double far = opaque != nullptr ? opaque_z_[pixel] + depth_reach(*opaque) : -kFar;
+  for (int i = 0; i < n; ++i) {
+    if (area[i] == 0.0) continue;
+    covered += area[i];
+    far = std::max(far, tri[i]->depth_at(x + 0.5, y + 0.5) + depth_reach(*tri[i]));
+  }
+  if (opaque != nullptr || covered >= 1.0 - 1e-9) {
+    constexpr double kMargin = 1e-9;
+    occluder_z_[pixel] = std::min(occluder_z_[pixel], far + kMargin);
+  }
+  // Members of an open or closed set stay: the set's sums and counts stand for them.
+  int i = 0;
+  remove_fragments(pixel, [&](const Fragment& f) {
+    return area[i++] == 0.0 && !(f.coverage & (kOpenFlag | kClosedFlag));
+  });
+  if (area[n - 1] == 0.0) return Compaction::NewHidden;
+  // Half the list at least, so that each clipping of the list pays for many fragments.
+  return count_[pixel] <= mixed_capacity_ / 2 ? Compaction::Room : Compaction::Full;
 }
 }  // namespace covrast::detail

@@ -6,6 +6,7 @@
 #include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/sample_mask.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
+#include "raster/coverage/visible_parts.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -217,6 +218,10 @@ void ABufferTile::resolve_logged(std::size_t pixel, int x, int y, glm::vec3 back
     depth_[pixel] = opaque != nullptr ? std::min(sums.depth, float(opaque_z_[pixel])) : sums.depth;
     return;
   }
+  if (resolve_clipped_log(pixel, x, y, background)) {
+    ++paths_.clipped;
+    return;
+  }
   ++paths_.masked;
   resolve_masked(pixel, x, y, background);
 }
@@ -246,6 +251,46 @@ void ABufferTile::resolve_proven(std::size_t pixel, int x, int y) {
   COVRAST_CHECK(sums.coverage >= std::uint32_t(kCoverageOne), "a proven layer fills its pixel");
   color_[pixel] = front_layer_color(sums, glm::vec3(0.0f));  // nothing of what is behind shows
   depth_[pixel] = sums.depth;
+}
+
+bool ABufferTile::resolve_clipped_log(std::size_t pixel, int x, int y, glm::vec3 background) {
+  const int n = int(log_.count(pixel));
+  if (!clipping_on_ || n > kMaxClippedLog) return false;
+  const TriangleSetup* opaque = opaque_[pixel];
+  // A textured fragment that shows in part is shaded over the samples it keeps
+  // (resolve_masked), which the clipping does not give.
+  if (opaque != nullptr && textured(*opaque)) return false;
+  const TriangleSetup* tri[kMaxClippedLog] = {};
+  float centre_z[kMaxClippedLog] = {};
+  int k = 0;
+  bool any_textured = false;
+  log_.for_each(pixel, [&](const LoggedFragment& f) {
+    any_textured = any_textured || textured(*f.triangle);
+    centre_z[k] = float(f.centre_z);
+    tri[k++] = f.triangle;
+  });
+  double area[kMaxClippedLog];
+  if (any_textured || !visible_areas(n, tri, opaque, x, y, area)) return false;
+  double total = 0.0;
+  for (int i = 0; i < n; ++i) total += area[i];
+  // The visible parts are disjoint: their sum exceeds the pixel by rounding at most.
+  const double scale = total > 1.0 ? 1.0 / total : 1.0;
+  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
+  glm::dvec3 rgb(0.0);
+  float depth = std::numeric_limits<float>::infinity();
+  for (int i = 0; i < n; ++i) {
+    if (area[i] == 0.0) continue;
+    depth = std::min(depth, centre_z[i]);
+    rgb += area[i] * scale * glm::dvec3(shade_fragment(*tri[i], x, y));
+  }
+  glm::vec3 behind = background;
+  if (opaque != nullptr && rest > 0.0) {
+    behind = shade_fragment(*opaque, x, y);
+    depth = std::min(depth, float(opaque_z_[pixel]));
+  }
+  color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(behind));
+  depth_[pixel] = depth;
+  return true;
 }
 
 void ABufferTile::resolve_masked(std::size_t pixel, int x, int y, glm::vec3 background) {

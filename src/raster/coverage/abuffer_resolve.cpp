@@ -9,6 +9,7 @@
 #include "raster/coverage/abuffer_planes.hpp"
 #include "raster/coverage/fragment_shading.hpp"
 #include "raster/coverage/triangle_overlap.hpp"
+#include "raster/coverage/visible_parts.hpp"
 
 #include <algorithm>
 #include <cstddef>
@@ -169,6 +170,12 @@ struct ABufferTile::ListFragments {
   int shown_side = -1;               ///< a fragment whose colour is `shown_side_color`
   glm::vec3 shown_side_color{0.0f};  ///< what shows of it (shade_fragment_visible)
 
+  bool any_merged() const {
+    for (int i = 0; i < n; ++i) {
+      if (merged[i] != nullptr) return true;
+    }
+    return false;
+  }
   glm::vec3 color(int i, int x, int y) const {
     if (i == shown_side) return shown_side_color;
     return merged[i] != nullptr ? merged[i]->color : shade_fragment(*tri[i], x, y);
@@ -305,6 +312,14 @@ glm::vec3 ABufferTile::resolve_pixel(std::size_t pixel, int x, int y, glm::vec3 
     took(&CoverageResolvePaths::clipped);
     weight[0] = double(l.cov[0]) / kCoverageOne * share;
     show_crossing_sides(l, *opaque, x, y, weight[0], tr, behind);
+  } else if (sums_allowed && clipping_on_ && l.n <= kMaxVisibleFragments && !l.any_merged() &&
+             visible_areas(l.n, l.tri, opaque, x, y, weight)) {
+    // Any other mix: each fragment's visible part by exact clipping (visible_parts.hpp). A
+    // merged fragment (pieces under one colour, each with its own plane) or a pixel too
+    // complex for the clipping's bounds takes the samples. A fragment's 8.8 coverage is its
+    // area as the kernel rounds it: the exact part may exceed it by that rounding.
+    took(&CoverageResolvePaths::clipped);
+    for (int i = 0; i < l.n; ++i) weight[i] = std::min(weight[i], double(l.cov[i]) / kCoverageOne);
   } else {
     took(&CoverageResolvePaths::samples);
     bool estimated[kMaxFragmentsPerPixel];

@@ -22,6 +22,14 @@ bool ABufferTile::overflow_fragment(std::size_t pixel, int x, int y, const Trian
       merge_into_open_set(pixel, x, y, *t, coverage, centre_z)) {
     return true;
   }
+  switch (drop_hidden(pixel, x, y, *t)) {
+    case Compaction::NewHidden:
+      return true;
+    case Compaction::Room:
+      return false;  // add_fragment stores t
+    case Compaction::Full:
+      break;
+  }
   to_samples(pixel, x, y);
   add_to_samples(pixel, x, y, *t);
   bound_by_samples(pixel);  // once the list and t are all in the samples
