@@ -5,11 +5,15 @@
 
 #include <covrast/error.hpp>
 #include <covrast/options.hpp>
+#include <covrast/renderer.hpp>
 #include <covrast/scene.hpp>
 
 #include <catch2/catch.hpp>
 
+#include <bit>
+#include <cstdint>
 #include <fstream>
+#include <memory>
 #include <string>
 
 namespace {
@@ -71,4 +75,44 @@ TEST_CASE("fuzz regression: an input error is one line whatever the input quoted
   }
   // UTF-8 (a file name, say) is kept as it is.
   CHECK(std::string(covrast::InputError("a\nb: caf\xc3\xa9").what()) == "a?b: caf\xc3\xa9");
+}
+
+// fuzz_render, crash-6b0dcfa6: triangles with NaN corners, clipped, set up with NaN depth
+// slopes; the exact clipping of a mixed pixel (visible_parts.hpp) took both fragments as
+// visible all over their parts and a debug check stopped the render (their areas did not fit
+// in the pixel). A plane that is not finite now leaves the pixel to the samples.
+TEST_CASE("fuzz regression: NaN depth planes leave a mixed pixel to the samples",
+          "[fuzz][coverage]") {
+  const std::uint32_t bits[2][9] = {{0xbf4ccccd, 0xbf333333, 0x00000000, 0x3f666666, 0xbe4ccccd,
+                                     0x00000000, 0xffffffff, 0xffffffff, 0xffffffff},
+                                    {0xffffffff, 0xffffffff, 0xffffffff, 0xcccccdff, 0x666666bd,
+                                     0x0000003f, 0x00000000, 0x0000003f, 0x8000003f}};
+  auto mesh = std::make_shared<covrast::MeshData>();
+  mesh->source = "fuzz";
+  for (const auto& triangle : bits) {
+    for (int corner = 0; corner < 3; ++corner) {
+      mesh->indices.push_back(std::uint32_t(mesh->positions.size()));
+      mesh->positions.push_back({std::bit_cast<float>(triangle[3 * corner]),
+                                 std::bit_cast<float>(triangle[3 * corner + 1]),
+                                 std::bit_cast<float>(triangle[3 * corner + 2])});
+    }
+  }
+  covrast::analyze_mesh_topology(*mesh);
+  covrast::Scene scene;
+  scene.width = 9;
+  scene.height = 7;
+  scene.background_linear = glm::vec3(0.02f, 0.05f, 0.1f);
+  covrast::add_instance(scene, mesh, covrast::InstanceDesc{});
+  covrast::check_scene(scene);
+  covrast::RenderOptions options;
+  options.mode = covrast::parse_render_mode("coverage");
+  options.want_depth = true;
+  options.tile = 8;
+  options.threads = 1;
+  const covrast::RenderResult a = covrast::render(scene, options);
+  options.tile = 24;
+  options.threads = 2;
+  const covrast::RenderResult b = covrast::render(scene, options);
+  CHECK(a.color.rgb == b.color.rgb);
+  CHECK(a.stats.resolve_paths.total() == std::uint64_t(scene.width) * scene.height);
 }

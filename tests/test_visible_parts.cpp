@@ -16,6 +16,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <random>
 #include <vector>
@@ -133,6 +134,24 @@ TEST_CASE("visible parts: identical planes give their overlap to the earlier pri
   CHECK(area[0] == 0.0);                                // primitive 7: hidden by its copy
   CHECK(area[1] == Approx(0.5 - 0.125).margin(1e-12));  // its part (x + y <= 1) less small's
   CHECK(area[2] == Approx(0.125).margin(1e-12));
+}
+
+TEST_CASE("visible parts: a plane that is not finite leaves the pixel to the samples",
+          "[coverage][clipping]") {
+  // The set-up of a degenerate triangle far out in the guard band can give NaN slopes (the
+  // fuzzer found one): no order of depths exists, and the clipping declines the pixel.
+  const TriangleSetup a = covering(0.5, 0.0, 0.0, 1);
+  TriangleSetup b = covering(0.4, 0.0, 0.0, 2);
+  b.dzdx = std::numeric_limits<double>::quiet_NaN();
+  const TriangleSetup* tris[2] = {&a, &b};
+  double area[2];
+  CHECK_FALSE(visible_areas(2, tris, nullptr, 0, 0, area));
+  CHECK_FALSE(visible_areas(1, tris, &b, 0, 0, area));  // as the opaque surface
+  b.dzdx = 0.0;
+  b.dzdy = std::numeric_limits<double>::infinity();
+  CHECK_FALSE(visible_areas(2, tris, nullptr, 0, 0, area));
+  CHECK(visible_areas(1, tris, nullptr, 0, 0, area));
+  CHECK(area[0] == Approx(1.0).margin(1e-12));
 }
 
 TEST_CASE("visible parts: a tessellation of the pixel keeps every piece", "[coverage][clipping]") {

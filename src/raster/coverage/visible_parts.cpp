@@ -216,6 +216,11 @@ bool never_in_front(const Line& d) {
 /// Whether `d` is the zero plane (the two planes are the same).
 bool same_plane(const Line& d) { return d.c == 0.0 && d.a == 0.0 && d.b == 0.0; }
 
+/// Whether t's plane is finite over pixel (x, y): its slopes and its depth at the corner.
+bool finite_plane(const TriangleSetup& t, int x, int y) {
+  return std::isfinite(t.dzdx) && std::isfinite(t.dzdy) && std::isfinite(t.depth_at(x, y));
+}
+
 /// Fragment i's visible part: its pieces less the opaque surface and every fragment of
 /// `order` (nearest first) that may lie in front of it and is not known to be hidden.
 bool visible_area_of(int i, int n, const Fragment* f, const int* order, const double* near,
@@ -265,12 +270,17 @@ bool visible_areas(int n, const TriangleSetup* const* tri, const TriangleSetup* 
   double near_of[kMaxVisibleFragments], far_of[kMaxVisibleFragments];
   double near[kMaxVisibleFragments];  // near_of in `order`
   bool done[kMaxVisibleFragments];
+  // A plane that is not finite (set-up of a degenerate triangle far out in the guard band)
+  // orders nothing: the samples decide, as they do for every comparison with it.
+  if (opaque != nullptr && !finite_plane(*opaque, x, y)) return false;
   for (int i = 0; i < n; ++i) {
+    if (!finite_plane(*tri[i], x, y)) return false;
     prepare(*tri[i], x, y, f[i]);
     const Line z{f[i].z, tri[i]->dzdx, tri[i]->dzdy};
     const double c[4] = {z.at(0, 0), z.at(1, 0), z.at(0, 1), z.at(1, 1)};
     near_of[i] = std::min(std::min(c[0], c[1]), std::min(c[2], c[3]));
     far_of[i] = std::max(std::max(c[0], c[1]), std::max(c[2], c[3]));
+    if (!std::isfinite(near_of[i]) || !std::isfinite(far_of[i])) return false;
     order[i] = i;
     done[i] = false;
     area[i] = 0.0;

@@ -18,8 +18,8 @@
 // difference z_i - z_j is evaluated in pixel-local coordinates from coefficients that are
 // exact negations of those of z_j - z_i, so two fragments never both claim a point of
 // their overlap that is off the line where they meet. A pixel whose pieces would exceed
-// kMaxPieces per fragment, or a piece kMaxVertices, returns false: the caller resolves it
-// by samples instead.
+// kMaxVisiblePieces per fragment, or a piece 16 vertices, returns false: the caller resolves it
+// by samples instead, as does a pixel with a plane that is not finite.
 #pragma once
 
 #include "core/triangle_setup.hpp"
@@ -33,8 +33,8 @@ inline constexpr int kMaxVisibleFragments = 64;
 
 /// area[i] = the area [pixels] of the part of fragment tri[i] in pixel (x, y) that no other
 /// fragment of the pixel and not the opaque surface (null: none) lies in front of; n <=
-/// kMaxVisibleFragments. False when the pixel is too complex for the bounds above (area is then
-/// unspecified).
+/// kMaxVisibleFragments. False when the pixel is too complex for the bounds above or a plane is
+/// not finite (area is then unspecified).
 bool visible_areas(int n, const TriangleSetup* const* tri, const TriangleSetup* opaque, int x,
                    int y, double* area);
 
