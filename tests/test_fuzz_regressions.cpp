@@ -1,6 +1,7 @@
 // Regression tests for what the fuzz targets (tests/fuzz, docs/testing.md) found: each input
 // that once crashed a target, rebuilt here in the test. The crashing files themselves are in
 // tests/fuzz/regressions/NAME and are replayed by the fuzz build's ctest (fuzz_replay_NAME).
+#include "fuzz/render_splits.hpp"
 #include "test_tempdir.hpp"
 
 #include <covrast/error.hpp>
@@ -107,12 +108,7 @@ TEST_CASE("fuzz regression: NaN depth planes leave a mixed pixel to the samples"
   covrast::RenderOptions options;
   options.mode = covrast::parse_render_mode("coverage");
   options.want_depth = true;
-  options.tile = 8;
-  options.threads = 1;
-  const covrast::RenderResult a = covrast::render(scene, options);
-  options.tile = 24;
-  options.threads = 2;
-  const covrast::RenderResult b = covrast::render(scene, options);
+  const auto [a, b] = covrast::fuzz::render_two_splits(scene, options);
   CHECK(a.color.rgb == b.color.rgb);
   CHECK(a.stats.resolve_paths.total() == std::uint64_t(scene.width) * scene.height);
 }

@@ -18,6 +18,7 @@
 // are dropped at load time, but the renderer must not depend on that), and the scene must pass
 // check_scene, as a program's scene would (a non-finite matrix or a bad camera is skipped).
 #include "fuzz_support.hpp"
+#include "render_splits.hpp"
 
 #include <covrast/renderer.hpp>
 
@@ -134,12 +135,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   options.mode = covrast::parse_render_mode(mode);
   options.cull_hidden_backfaces = (flags & kNoCull) == 0;
   options.want_depth = (flags & kDepth) != 0;
-  options.tile = 8;
-  options.threads = 1;
-  const covrast::RenderResult a = covrast::render(scene, options);
-  options.tile = 24;
-  options.threads = 2;
-  const covrast::RenderResult b = covrast::render(scene, options);
+  const auto [a, b] = covrast::fuzz::render_two_splits(scene, options);
   if (a.color.width != scene.width || a.color.height != scene.height ||
       a.color.rgb.size() != std::size_t(scene.width) * scene.height * 3) {
     std::fprintf(stderr, "covrast fuzz: %dx%d image for a %dx%d scene in mode %s\n", a.color.width,

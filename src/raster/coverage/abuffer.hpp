@@ -71,6 +71,11 @@ inline constexpr int kMaxFragmentsPerPixel = 128;
 /// depth-tested samples instead, at the cost of MSAA per further fragment.
 inline constexpr int kMaxMixedFragments = 32;
 
+/// The margin a pixel's depth bound (occluder_z_) keeps behind the farthest depth that fills
+/// the pixel (its samples', or its visible parts'): far above the rounding of a centre depth,
+/// a reach and a plane value (all within 1e-15 of their exact values in [0, 1]).
+inline constexpr double kOccluderMargin = 1e-9;
+
 /// Block side [pixels] of the A-buffer's block-level fast path.
 inline constexpr int kAbufferBlockPx = 8;
 
@@ -111,6 +116,31 @@ inline bool share_vertex(const TriangleSetup& a, const TriangleSetup& b) {
 inline bool one_convex_facing(const TriangleSetup& a, const TriangleSetup& b) {
   return a.convex_surface && b.convex_surface && a.surface == b.surface &&
          a.front_facing == b.front_facing;
+}
+
+/// How a pixel's visible weights w_i (each at most its fragment's area) share it: colour =
+/// scale sum_i w_i c_i + rest behind. Visible parts are disjoint, so their sum passes the
+/// pixel only by rounding or where samples and areas disagree: then the weights are
+/// normalised and nothing behind shows.
+struct PixelShares {
+  double scale = 1.0;
+  double rest = 1.0;
+};
+
+inline PixelShares pixel_shares(int n, const double* weight) {
+  double total = 0.0;
+  for (int i = 0; i < n; ++i) total += weight[i];
+  return {total > 1.0 ? 1.0 / total : 1.0, total > 1.0 ? 0.0 : 1.0 - total};
+}
+
+/// scale sum_i w_i c_i over the fragments with a weight, c_i = color_of(i), in index order.
+template <class ColorOf>
+glm::dvec3 weighted_sum(int n, const double* weight, double scale, const ColorOf& color_of) {
+  glm::dvec3 rgb(0.0);
+  for (int i = 0; i < n; ++i) {
+    if (weight[i] != 0.0) rgb += weight[i] * scale * glm::dvec3(color_of(i));
+  }
+  return rgb;
 }
 
 class ABufferTile {

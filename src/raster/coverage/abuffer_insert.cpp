@@ -162,8 +162,7 @@ ABufferTile::Compaction ABufferTile::drop_hidden(std::size_t pixel, int x, int y
     far = std::max(far, tri[i]->depth_at(x + 0.5, y + 0.5) + depth_reach(*tri[i]));
   }
   if (opaque != nullptr || covered >= 1.0 - 1e-9) {
-    constexpr double kMargin = 1e-9;
-    occluder_z_[pixel] = std::min(occluder_z_[pixel], far + kMargin);
+    occluder_z_[pixel] = std::min(occluder_z_[pixel], far + kOccluderMargin);
   }
   // Members of an open or closed set stay: the set's sums and counts stand for them.
   int i = 0;

@@ -271,24 +271,19 @@ bool ABufferTile::resolve_clipped_log(std::size_t pixel, int x, int y, glm::vec3
   });
   double area[kMaxClippedLog];
   if (any_textured || !visible_areas(n, tri, opaque, x, y, area)) return false;
-  double total = 0.0;
-  for (int i = 0; i < n; ++i) total += area[i];
-  // The visible parts are disjoint: their sum exceeds the pixel by rounding at most.
-  const double scale = total > 1.0 ? 1.0 / total : 1.0;
-  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
-  glm::dvec3 rgb(0.0);
+  const PixelShares shares = pixel_shares(n, area);
+  const glm::dvec3 rgb =
+      weighted_sum(n, area, shares.scale, [&](int i) { return shade_fragment(*tri[i], x, y); });
   float depth = std::numeric_limits<float>::infinity();
   for (int i = 0; i < n; ++i) {
-    if (area[i] == 0.0) continue;
-    depth = std::min(depth, centre_z[i]);
-    rgb += area[i] * scale * glm::dvec3(shade_fragment(*tri[i], x, y));
+    if (area[i] != 0.0) depth = std::min(depth, centre_z[i]);
   }
   glm::vec3 behind = background;
-  if (opaque != nullptr && rest > 0.0) {
+  if (opaque != nullptr && shares.rest > 0.0) {
     behind = shade_fragment(*opaque, x, y);
     depth = std::min(depth, float(opaque_z_[pixel]));
   }
-  color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(behind));
+  color_[pixel] = glm::vec3(rgb + shares.rest * glm::dvec3(behind));
   depth_[pixel] = depth;
   return true;
 }
@@ -305,23 +300,19 @@ void ABufferTile::resolve_masked(std::size_t pixel, int x, int y, glm::vec3 back
   p.sort_nearest_first();
   p.take_samples(x, y);
   p.weigh(x, y);
-  double total = 0.0;
-  for (int i = 0; i < p.considered; ++i) total += p.weight[i];
-  const double scale = total > 1.0 ? 1.0 / total : 1.0;
-  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
-  glm::dvec3 rgb(0.0);
   float depth = std::numeric_limits<float>::infinity();
   for (int i = 0; i < p.considered; ++i) {
     COVRAST_CHECK(p.weight[i] >= 0.0 && p.weight[i] <= p.area(i) * (1.0 + 1e-9),
                   "a fragment's visible weight lies between 0 and its exact area");
     depth = std::min(depth, float(p.centre_z[i]));
-    if (p.weight[i] == 0.0) continue;
-    const glm::vec3 color = p.shows_partly(i, scale)
-                                ? shade_fragment_visible(*p.tri[i], x, y, p.mask[i], p.kept[i])
-                                : shade_fragment(*p.tri[i], x, y);
-    rgb += p.weight[i] * scale * glm::dvec3(color);
   }
-  color_[pixel] = glm::vec3(rgb + rest * glm::dvec3(background));
+  const PixelShares shares = pixel_shares(p.considered, p.weight);
+  const glm::dvec3 rgb = weighted_sum(p.considered, p.weight, shares.scale, [&](int i) {
+    return p.shows_partly(i, shares.scale)
+               ? shade_fragment_visible(*p.tri[i], x, y, p.mask[i], p.kept[i])
+               : shade_fragment(*p.tri[i], x, y);
+  });
+  color_[pixel] = glm::vec3(rgb + shares.rest * glm::dvec3(background));
   depth_[pixel] = depth;
 }
 

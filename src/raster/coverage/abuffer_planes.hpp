@@ -4,6 +4,7 @@
 // -ffp-contract=off), so that two comparisons of one plane never see different bits.
 #pragma once
 
+#include "core/convex_polygon.hpp"
 #include "core/triangle_setup.hpp"
 #include "raster/coverage/sample_mask.hpp"
 
@@ -61,38 +62,14 @@ inline bool behind_all_over(const TriangleSetup& far, const TriangleSetup& near,
 
 /// A convex polygon in pixel coordinates: the pixel square clipped by up to six lines (each
 /// line adds at most one vertex).
-struct ClipPolygon {
-  double x[10], y[10];
-  int n = 0;
-};
+using ClipPolygon = Polygon<10>;
 
 /// Keeps the part of `poly` where the affine function f(x, y) = c + a x + b y is >= 0.
-inline void clip_half_plane(ClipPolygon& poly, double c, double a, double b) {
+inline void clip_to_line(ClipPolygon& poly, double c, double a, double b) {
   ClipPolygon out;
-  for (int i = 0; i < poly.n; ++i) {
-    const int j = (i + 1) % poly.n;
-    const double fi = c + a * poly.x[i] + b * poly.y[i];
-    const double fj = c + a * poly.x[j] + b * poly.y[j];
-    if (fi >= 0) {
-      out.x[out.n] = poly.x[i];
-      out.y[out.n++] = poly.y[i];
-    }
-    if ((fi >= 0) != (fj >= 0)) {
-      const double u = fi / (fi - fj);
-      out.x[out.n] = poly.x[i] + u * (poly.x[j] - poly.x[i]);
-      out.y[out.n++] = poly.y[i] + u * (poly.y[j] - poly.y[i]);
-    }
-  }
+  clip_polygon(
+      poly, [&](double px, double py) { return c + a * px + b * py; }, out);
   poly = out;
-}
-
-inline double polygon_area(const ClipPolygon& poly) {
-  double twice = 0;
-  for (int i = 0; i < poly.n; ++i) {
-    const int j = (i + 1) % poly.n;
-    twice += poly.x[i] * poly.y[j] - poly.x[j] * poly.y[i];
-  }
-  return 0.5 * std::fabs(twice);
 }
 
 /// Keeps the part of `poly` inside triangle `t` (its three edges).
@@ -104,7 +81,7 @@ inline void clip_by_triangle(ClipPolygon& poly, const TriangleSetup& t) {
     const int j = (i + 1) % 3;
     const double xi = t.x_fx8[i] * s, yi = t.y_fx8[i] * s;
     const double dx = t.x_fx8[j] * s - xi, dy = t.y_fx8[j] * s - yi;
-    clip_half_plane(poly, dy * xi - dx * yi, -dy, dx);
+    clip_to_line(poly, dy * xi - dx * yi, -dy, dx);
   }
 }
 

@@ -123,7 +123,7 @@ double visible_share(const TriangleSetup& t, const TriangleSetup& o, int x, int 
   if (!(inside > 1e-12)) return -1.0;
   // Nearer where d = z_o - z_t > 0; d is affine: d(p) = d0 + ddx x + ddy y.
   const double d0 = o.depth_at(0.0, 0.0) - t.depth_at(0.0, 0.0);
-  clip_half_plane(poly, d0, o.dzdx - t.dzdx, o.dzdy - t.dzdy);
+  clip_to_line(poly, d0, o.dzdx - t.dzdx, o.dzdy - t.dzdy);
   return std::clamp(polygon_area(poly) / inside, 0.0, 1.0);
 }
 
@@ -259,18 +259,16 @@ glm::vec3 ABufferTile::list_weighted_color(const ListFragments& l, const double*
                                            int y) {
   // colour = sum_i w_i c_i + (1 - sum_i w_i) behind, the weights normalised when they exceed
   // the pixel.
-  double total = 0;
   for (int i = 0; i < l.n; ++i) {
     COVRAST_CHECK(weight[i] >= 0.0 && weight[i] <= double(l.cov[i]) / kCoverageOne * (1.0 + 1e-9),
                   "a fragment's visible weight lies between 0 and its exact area");
-    total += weight[i];
   }
-  const double scale = total > 1.0 ? 1.0 / total : 1.0;
-  const double rest = total > 1.0 ? 0.0 : 1.0 - total;
+  const PixelShares shares = pixel_shares(l.n, weight);
+  const double rest = shares.rest;
   double rgb[3] = {rest * behind.r, rest * behind.g, rest * behind.b};
   for (int i = 0; i < l.n; ++i) {
     if (weight[i] == 0) continue;
-    add_kept(rgb, weight[i] * scale, tr, l.tri[i], l.color(i, x, y));
+    add_kept(rgb, weight[i] * shares.scale, tr, l.tri[i], l.color(i, x, y));
   }
   return glm::vec3(float(rgb[0]), float(rgb[1]), float(rgb[2]));
 }

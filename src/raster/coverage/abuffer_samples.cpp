@@ -82,9 +82,8 @@ void ABufferTile::bound_by_samples(std::size_t pixel) {
   }
   const double farthest = std::max(std::max(far[0], far[1]), std::max(far[2], far[3]));
   // The margin keeps the test on the safe side of the rounding of the centre depth, the
-  // reach and each sample's plane value (all within 1e-15 of their exact values in [0, 1]).
-  constexpr double kMargin = 1e-9;
-  occluder_z_[pixel] = std::min(occluder_z_[pixel], farthest + kMargin);
+  // reach and each sample's plane value.
+  occluder_z_[pixel] = std::min(occluder_z_[pixel], farthest + kOccluderMargin);
 }
 
 bool ABufferTile::add_to_samples(std::size_t pixel, int x, int y, const TriangleSetup& t) {

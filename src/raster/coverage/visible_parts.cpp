@@ -3,6 +3,7 @@
 #include "raster/coverage/visible_parts.hpp"
 
 #include "core/checks.hpp"
+#include "core/convex_polygon.hpp"
 #include "raster/coverage/sample_mask.hpp"
 
 #include <algorithm>
@@ -19,53 +20,15 @@ struct Line {
   Line flipped() const { return {-c, -a, -b}; }
 };
 
-/// A convex polygon in pixel-local coordinates. Each cut adds at most one vertex.
-struct Piece {
-  static constexpr int kMaxVertices = 16;
-  double u[kMaxVertices], v[kMaxVertices];
-  int n = 0;
-};
-
-/// dst = src, copying only the vertices in use.
-void assign(Piece& dst, const Piece& src) {
-  dst.n = src.n;
-  for (int i = 0; i < src.n; ++i) {
-    dst.u[i] = src.u[i];
-    dst.v[i] = src.v[i];
-  }
-}
+/// A convex polygon in pixel-local coordinates (x, y in [0, 1] over the pixel). Each cut adds
+/// at most one vertex.
+using Piece = Polygon<16>;
 
 /// Keeps the part of `in` inside `line` in `out`; false when it would need more vertices than
 /// a piece holds.
 bool clip(const Piece& in, const Line& line, Piece& out) {
-  out.n = 0;
-  for (int i = 0; i < in.n; ++i) {
-    const int j = i + 1 == in.n ? 0 : i + 1;
-    const double fi = line.at(in.u[i], in.v[i]);
-    const double fj = line.at(in.u[j], in.v[j]);
-    if (fi >= 0.0) {
-      if (out.n == Piece::kMaxVertices) return false;
-      out.u[out.n] = in.u[i];
-      out.v[out.n++] = in.v[i];
-    }
-    if ((fi >= 0.0) != (fj >= 0.0)) {
-      if (out.n == Piece::kMaxVertices) return false;
-      const double s = fi / (fi - fj);
-      out.u[out.n] = in.u[i] + s * (in.u[j] - in.u[i]);
-      out.v[out.n++] = in.v[i] + s * (in.v[j] - in.v[i]);
-    }
-  }
-  return true;
-}
-
-/// |shoelace sum| / 2.
-double area_of(const Piece& p) {
-  double twice = 0.0;
-  for (int i = 0; i < p.n; ++i) {
-    const int j = i + 1 == p.n ? 0 : i + 1;
-    twice += p.u[i] * p.v[j] - p.u[j] * p.v[i];
-  }
-  return 0.5 * std::fabs(twice);
+  return clip_polygon(
+      in, [&](double u, double v) { return line.at(u, v); }, out);
 }
 
 /// Pieces thinner than this are dropped: far below an 8.8 coverage step (1/65280), and it
@@ -95,24 +58,24 @@ void prepare(const TriangleSetup& t, int x, int y, Fragment& f) {
   Piece& part = f.part;
   part.n = 4;
   const double su[4] = {0.0, 1.0, 1.0, 0.0}, sv[4] = {0.0, 0.0, 1.0, 1.0};
-  std::copy(su, su + 4, part.u);
-  std::copy(sv, sv + 4, part.v);
+  std::copy(su, su + 4, part.x);
+  std::copy(sv, sv + 4, part.y);
   Piece cut;
   for (int i = 0; i < 3; ++i) {
     bool all_in = true;
-    for (int k = 0; k < part.n && all_in; ++k) all_in = f.edge[i].at(part.u[k], part.v[k]) >= 0.0;
+    for (int k = 0; k < part.n && all_in; ++k) all_in = f.edge[i].at(part.x[k], part.y[k]) >= 0.0;
     if (all_in) continue;        // the edge misses what is left
     clip(part, f.edge[i], cut);  // a triangle and a square: at most 7 vertices
-    assign(part, cut);
+    part.assign(cut);
   }
   f.z = t.depth_at(x, y);
   f.u0 = f.v0 = 1.0;
   f.u1 = f.v1 = 0.0;
   for (int i = 0; i < f.part.n; ++i) {
-    f.u0 = std::min(f.u0, f.part.u[i]);
-    f.u1 = std::max(f.u1, f.part.u[i]);
-    f.v0 = std::min(f.v0, f.part.v[i]);
-    f.v1 = std::max(f.v1, f.part.v[i]);
+    f.u0 = std::min(f.u0, f.part.x[i]);
+    f.u1 = std::max(f.u1, f.part.x[i]);
+    f.v0 = std::min(f.v0, f.part.y[i]);
+    f.v1 = std::max(f.v1, f.part.y[i]);
   }
 }
 
@@ -138,7 +101,7 @@ Cut cut(const Piece& q, const Line* lines, int m, Pieces& out) {
   for (int k = 0; k < m; ++k) {
     bool all_in = true, all_out = true;
     for (int i = 0; i < q.n; ++i) {
-      const double f = lines[k].at(q.u[i], q.v[i]);
+      const double f = lines[k].at(q.x[i], q.y[i]);
       all_in = all_in && f >= 0.0;
       all_out = all_out && f <= 0.0;
     }
@@ -154,7 +117,7 @@ Cut cut(const Piece& q, const Line* lines, int m, Pieces& out) {
     if (out.n == kMaxVisiblePieces) return Cut::Overflow;
     Piece& outside = out.piece[out.n];
     if (!clip(*rest, lines[k].flipped(), outside)) return Cut::Overflow;
-    if (area_of(outside) > kNegligibleArea) ++out.n;
+    if (polygon_area(outside) > kNegligibleArea) ++out.n;
     Piece& inside = buffer[k & 1];
     if (!clip(*rest, lines[k], inside)) return Cut::Overflow;
     rest = &inside;
@@ -171,7 +134,7 @@ bool remove_set(Pieces& pieces, const Line* lines, int m) {
   for (int p = 0; p < pieces.n; ++p) {
     switch (cut(pieces.piece[p], lines, m, added)) {
       case Cut::Unchanged:
-        if (kept != p) assign(pieces.piece[kept], pieces.piece[p]);
+        if (kept != p) pieces.piece[kept].assign(pieces.piece[p]);
         ++kept;
         break;
       case Cut::Removed:
@@ -181,7 +144,7 @@ bool remove_set(Pieces& pieces, const Line* lines, int m) {
     }
   }
   if (kept + added.n > kMaxVisiblePieces) return false;
-  for (int a = 0; a < added.n; ++a) assign(pieces.piece[kept++], added.piece[a]);
+  for (int a = 0; a < added.n; ++a) pieces.piece[kept++].assign(added.piece[a]);
   pieces.n = kept;
   return true;
 }
@@ -221,17 +184,29 @@ bool finite_plane(const TriangleSetup& t, int x, int y) {
   return std::isfinite(t.dzdx) && std::isfinite(t.dzdy) && std::isfinite(t.depth_at(x, y));
 }
 
+/// One pixel's fragments, prepared, and the order the walk takes them in.
+struct PixelFragments {
+  int n = 0;
+  Fragment f[kMaxVisibleFragments];
+  int order[kMaxVisibleFragments];    ///< indices into f, nearest first
+  double near[kMaxVisibleFragments];  ///< the nearest depth over the pixel, in `order`
+  double far[kMaxVisibleFragments];   ///< the farthest depth over the pixel, by index
+  bool done[kMaxVisibleFragments];    ///< whether its visible area is known, by index
+  const TriangleSetup* opaque = nullptr;
+  double opaque_z = 0.0;  ///< the opaque plane at the pixel's corner
+};
+
 /// Fragment i's visible part: its pieces less the opaque surface and every fragment of
 /// `order` (nearest first) that may lie in front of it and is not known to be hidden.
-bool visible_area_of(int i, int n, const Fragment* f, const int* order, const double* near,
-                     const double* far, const bool* done, const double* area,
-                     const TriangleSetup* opaque, double opaque_z, Pieces& pieces,
+bool visible_area_of(const PixelFragments& px, const double* area, int i, Pieces& pieces,
                      double& visible) {
+  const Fragment* f = px.f;
+  const TriangleSetup* opaque = px.opaque;
   const TriangleSetup& ti = *f[i].tri;
   pieces.n = 0;
-  if (area_of(f[i].part) > kNegligibleArea) assign(pieces.piece[pieces.n++], f[i].part);
+  if (polygon_area(f[i].part) > kNegligibleArea) pieces.piece[pieces.n++].assign(f[i].part);
   if (opaque != nullptr && pieces.n != 0) {
-    const Line d = in_front(f[i], *opaque, opaque_z);
+    const Line d = in_front(f[i], *opaque, px.opaque_z);
     const bool hidden_by_tie = same_plane(d) && opaque->primitive < ti.primitive;
     if (hidden_by_tie) pieces.n = 0;
     if (!hidden_by_tie && !never_in_front(d) && !remove_set(pieces, &d, 1)) return false;
@@ -239,9 +214,9 @@ bool visible_area_of(int i, int n, const Fragment* f, const int* order, const do
   // A point of i that some fragment hides is hidden by the nearest fragment there, which is
   // visible: fragments already found hidden need not be subtracted. Nearest first, so the
   // walk ends at the first fragment that starts behind i's farthest point.
-  for (int k = 0; k < n && pieces.n != 0 && near[k] <= far[i]; ++k) {
-    const int j = order[k];
-    if (j == i || (done[j] && area[j] == 0.0) || !boxes_overlap(f[i], f[j])) continue;
+  for (int k = 0; k < px.n && pieces.n != 0 && px.near[k] <= px.far[i]; ++k) {
+    const int j = px.order[k];
+    if (j == i || (px.done[j] && area[j] == 0.0) || !boxes_overlap(f[i], f[j])) continue;
     const TriangleSetup& tj = *f[j].tri;
     if (across_shared_edge(ti, tj)) continue;
     Line set[4] = {f[j].edge[0], f[j].edge[1], f[j].edge[2], in_front(f[i], tj, f[j].z)};
@@ -255,7 +230,7 @@ bool visible_area_of(int i, int n, const Fragment* f, const int* order, const do
     if (!remove_set(pieces, set, m)) return false;
   }
   visible = 0.0;
-  for (int p = 0; p < pieces.n; ++p) visible += area_of(pieces.piece[p]);
+  for (int p = 0; p < pieces.n; ++p) visible += polygon_area(pieces.piece[p]);
   return true;
 }
 
@@ -264,47 +239,43 @@ bool visible_area_of(int i, int n, const Fragment* f, const int* order, const do
 bool visible_areas(int n, const TriangleSetup* const* tri, const TriangleSetup* opaque, int x,
                    int y, double* area) {
   COVRAST_CHECK(n <= kMaxVisibleFragments, "visible_areas takes at most its limit");
-  static thread_local Fragment f[kMaxVisibleFragments];
+  static thread_local PixelFragments px;
   static thread_local Pieces pieces;
-  int order[kMaxVisibleFragments];
-  double near_of[kMaxVisibleFragments], far_of[kMaxVisibleFragments];
-  double near[kMaxVisibleFragments];  // near_of in `order`
-  bool done[kMaxVisibleFragments];
+  double near_of[kMaxVisibleFragments];
   // A plane that is not finite (set-up of a degenerate triangle far out in the guard band)
   // orders nothing: the samples decide, as they do for every comparison with it.
   if (opaque != nullptr && !finite_plane(*opaque, x, y)) return false;
+  px.n = n;
   for (int i = 0; i < n; ++i) {
     if (!finite_plane(*tri[i], x, y)) return false;
-    prepare(*tri[i], x, y, f[i]);
-    const Line z{f[i].z, tri[i]->dzdx, tri[i]->dzdy};
+    prepare(*tri[i], x, y, px.f[i]);
+    const Line z{px.f[i].z, tri[i]->dzdx, tri[i]->dzdy};
     const double c[4] = {z.at(0, 0), z.at(1, 0), z.at(0, 1), z.at(1, 1)};
     near_of[i] = std::min(std::min(c[0], c[1]), std::min(c[2], c[3]));
-    far_of[i] = std::max(std::max(c[0], c[1]), std::max(c[2], c[3]));
-    if (!std::isfinite(near_of[i]) || !std::isfinite(far_of[i])) return false;
-    order[i] = i;
-    done[i] = false;
+    px.far[i] = std::max(std::max(c[0], c[1]), std::max(c[2], c[3]));
+    if (!std::isfinite(near_of[i]) || !std::isfinite(px.far[i])) return false;
+    px.order[i] = i;
+    px.done[i] = false;
     area[i] = 0.0;
   }
   // Nearest first; equal nearest depth in primitive order, so the order is a function of
   // the fragments alone.
-  std::sort(order, order + n, [&](int a, int b) {
+  std::sort(px.order, px.order + n, [&](int a, int b) {
     if (near_of[a] != near_of[b]) return near_of[a] < near_of[b];
     return tri[a]->primitive < tri[b]->primitive;
   });
-  for (int k = 0; k < n; ++k) near[k] = near_of[order[k]];
-  const double opaque_z = opaque != nullptr ? opaque->depth_at(x, y) : 0.0;
+  for (int k = 0; k < n; ++k) px.near[k] = near_of[px.order[k]];
+  px.opaque = opaque;
+  px.opaque_z = opaque != nullptr ? opaque->depth_at(x, y) : 0.0;
   // Once the visible parts found fill the pixel, the fragments after them are hidden.
   constexpr double kFilled = 1.0 - 1e-9;
   double covered = 0.0;
   for (int k = 0; k < n && covered < kFilled; ++k) {
-    const int i = order[k];
-    if (!visible_area_of(i, n, f, order, near, far_of, done, area, opaque, opaque_z, pieces,
-                         area[i])) {
-      return false;
-    }
-    done[i] = true;
+    const int i = px.order[k];
+    if (!visible_area_of(px, area, i, pieces, area[i])) return false;
+    px.done[i] = true;
     covered += area[i];
-    COVRAST_CHECK(area[i] <= area_of(f[i].part) * (1.0 + 1e-9) + 1e-12,
+    COVRAST_CHECK(area[i] <= polygon_area(px.f[i].part) * (1.0 + 1e-9) + 1e-12,
                   "a visible part lies inside the fragment's part of the pixel");
   }
   COVRAST_CHECK(covered <= 1.0 + 1e-9, "the visible parts are disjoint: they fit in the pixel");
