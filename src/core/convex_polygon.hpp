@@ -48,10 +48,12 @@ struct Polygon {
 template <int kIn, int kOut, class Affine>
 bool clip_polygon(const Polygon<kIn>& in, const Affine& f, Polygon<kOut>& out) {
   out.n = 0;
+  double value[kIn];  // f at each vertex, once: each side reads its two ends
+  for (int i = 0; i < in.n; ++i) value[i] = f(in.x[i], in.y[i]);
   for (int i = 0; i < in.n; ++i) {
     const int j = i + 1 == in.n ? 0 : i + 1;
-    const double fi = f(in.x[i], in.y[i]);
-    const double fj = f(in.x[j], in.y[j]);
+    const double fi = value[i];
+    const double fj = value[j];
     if (fi >= 0.0 && !out.add(in.x[i], in.y[i])) return false;
     if ((fi >= 0.0) != (fj >= 0.0)) {  // the side crosses the line: its crossing
       const double s = fi / (fi - fj);

@@ -310,12 +310,12 @@ void read_block(const TextureLevel& level, const TexelDecoder& decode,
                 TexelBlock& block) {
   block.n = at.columns + order;
   block.m = at.rows + order;
+  int column[kMaxTexels];  // wrapped once per block, not once per texel
+  for (int x = 0; x < block.n; ++x) column[x] = wrap_texel(at.i0 + x, level.width, sampler.wrap_s);
   for (int y = 0; y < block.m; ++y) {
     const int row = wrap_texel(at.j0 + y, level.height, sampler.wrap_t);
-    for (int x = 0; x < block.n; ++x) {
-      block.texel[y * block.n + x] =
-          decode(level.at(wrap_texel(at.i0 + x, level.width, sampler.wrap_s), row));
-    }
+    for (int x = 0; x < block.n; ++x)
+      block.texel[y * block.n + x] = decode(level.at(column[x], row));
   }
 }
 
