@@ -80,11 +80,17 @@ double polygon_area(const Polygon<kCapacity>& p) {
 /// such a polygon clipped to another box at most 11.
 using ConvexPolygon = Polygon<12>;
 
+/// out = the part of `in` where a x + b y + c >= 0.
+inline void clip_half_plane(const ConvexPolygon& in, double a, double b, double c,
+                            ConvexPolygon& out) {
+  clip_polygon(
+      in, [&](double px, double py) { return a * px + b * py + c; }, out);
+}
+
 /// The part of `in` where a x + b y + c >= 0.
 inline ConvexPolygon clip_half_plane(const ConvexPolygon& in, double a, double b, double c) {
   ConvexPolygon out;
-  clip_polygon(
-      in, [&](double px, double py) { return a * px + b * py + c; }, out);
+  clip_half_plane(in, a, b, c, out);
   return out;
 }
 

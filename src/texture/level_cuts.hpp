@@ -57,10 +57,7 @@ struct LevelPolygon {
 /// than 3 vertices.
 inline bool cut_column(const LevelPolygon& at, int ps, ConvexPolygon& column) {
   COVRAST_CHECK(at.fits && ps > 0 && ps < at.columns, "a column cut inside the cells");
-  // As clip_half_plane(at.p, 1.0, 0.0, -s0) evaluates it, straight into `column`.
-  const double a = 1.0, b = 0.0, c = -double(at.i0 + ps);
-  clip_polygon(
-      at.p, [&](double px, double py) { return a * px + b * py + c; }, column);
+  clip_half_plane(at.p, 1.0, 0.0, -double(at.i0 + ps), column);  // straight into `column`
   return column.n >= 3;
 }
 

@@ -264,8 +264,7 @@ glm::vec3 ABufferTile::list_weighted_color(const ListFragments& l, const double*
                   "a fragment's visible weight lies between 0 and its exact area");
   }
   const PixelShares shares = pixel_shares(l.n, weight);
-  const double rest = shares.rest;
-  double rgb[3] = {rest * behind.r, rest * behind.g, rest * behind.b};
+  double rgb[3] = {shares.rest * behind.r, shares.rest * behind.g, shares.rest * behind.b};
   for (int i = 0; i < l.n; ++i) {
     if (weight[i] == 0) continue;
     add_kept(rgb, weight[i] * shares.scale, tr, l.tri[i], l.color(i, x, y));
